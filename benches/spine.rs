@@ -1,0 +1,97 @@
+//! Criterion benches of the spine: one function per operation.
+
+use criterion::{Criterion, criterion_group, criterion_main};
+use glam::{Vec2, Vec3};
+use prism::geometry::{Aabb, Ray};
+use prism::integrator::{Ctx, Integrator, RenderOptions, path::camera_ray, render};
+use prism::kdtree::{KdParams, KdTree};
+use prism::sampling::{Sampler, SamplerKind, square_to_uniform_sphere};
+use prism::systems::{RenderScene, prepare};
+use std::hint::black_box;
+use std::path::Path;
+
+fn cornell(size: u32, spp: u32) -> RenderScene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.ron");
+    let o = vec![
+        ("render.width".to_string(), size.to_string()),
+        ("render.height".to_string(), size.to_string()),
+        ("render.spp".to_string(), spp.to_string()),
+    ];
+    prepare(&prism::scene_file::load(&path, &o).unwrap(), &KdParams::default())
+}
+
+fn random_boxes(n: usize) -> Vec<Aabb> {
+    let s = Sampler::new(SamplerKind::Independent, 1);
+    (0..n as u32)
+        .map(|i| {
+            let c = Vec3::new(s.get_1d(i, 0, 0), s.get_1d(i, 0, 1), s.get_1d(i, 0, 2)) * 100.0;
+            let e = Vec3::new(s.get_1d(i, 0, 3), s.get_1d(i, 0, 4), s.get_1d(i, 0, 5)) + 0.1;
+            Aabb::new(c - e, c + e)
+        })
+        .collect()
+}
+
+fn kdtree(c: &mut Criterion) {
+    let mut g = c.benchmark_group("kdtree");
+    let boxes = random_boxes(10_000);
+    g.bench_function("build_10k_boxes", |b| {
+        b.iter(|| KdTree::build(black_box(&boxes[..]), &KdParams::default()))
+    });
+    let scene = cornell(64, 1);
+    let s = Sampler::new(SamplerKind::Independent, 3);
+    let rays: Vec<Ray> = (0..4096u32)
+        .map(|i| {
+            let o = Vec3::new(278.0, 273.0, 250.0) + square_to_uniform_sphere(s.get_2d(i, 0, 0)) * 100.0;
+            Ray::new(o, square_to_uniform_sphere(s.get_2d(i, 0, 2)))
+        })
+        .collect();
+    g.bench_function("closest_hit_cornell_4096", |b| {
+        b.iter(|| rays.iter().filter(|r| scene.intersect(r, f32::INFINITY).is_some()).count())
+    });
+    g.bench_function("any_hit_cornell_4096", |b| {
+        b.iter(|| rays.iter().filter(|r| scene.occluded(r, 300.0)).count())
+    });
+    g.finish();
+}
+
+fn camera(c: &mut Criterion) {
+    let mut g = c.benchmark_group("camera");
+    let scene = cornell(64, 1);
+    for (name, lens) in [("pinhole", false), ("lens", true)] {
+        let ctx = Ctx::new(&scene, lens);
+        g.bench_function(format!("rays_64x64_{name}"), |b| {
+            b.iter(|| {
+                let mut acc = Vec2::ZERO;
+                for y in 0..64 {
+                    for x in 0..64 {
+                        let s = camera_ray::<false>(&ctx, x, y, 0);
+                        acc += s.ray.d.truncate();
+                    }
+                }
+                acc
+            })
+        });
+    }
+    g.finish();
+}
+
+fn integrator(c: &mut Criterion) {
+    let mut g = c.benchmark_group("integrator");
+    g.sample_size(10);
+    let scene = cornell(64, 4);
+    for (name, integrator) in [("wavefront", Integrator::Wavefront), ("reference", Integrator::Reference)] {
+        let opts = RenderOptions {
+            sample_offset: 0,
+            spp: 4,
+            time_limit: None,
+            integrator,
+        };
+        g.bench_function(format!("cornell_64x64_4spp_{name}"), |b| {
+            b.iter(|| render(&scene, &opts, &|_| {}).stats.samples)
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, kdtree, camera, integrator);
+criterion_main!(benches);

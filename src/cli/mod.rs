@@ -1,0 +1,296 @@
+//! The `prism` command line: render, info, compare.
+
+mod progress;
+
+use crate::film::{self, ImageMeta, PngOptions};
+use crate::integrator::{self, Integrator, RenderOptions};
+use crate::kdtree::KdParams;
+use crate::scene_file::{self, LoadedScene};
+use crate::systems::{self, Effect, RenderScene};
+use clap::{Args, Parser, Subcommand};
+use std::fmt;
+use std::path::{Path, PathBuf};
+
+#[derive(Parser, Debug)]
+#[command(name = "prism", version, about = "A physically based spectral path tracer for RON scenes")]
+pub struct Cli {
+    #[command(subcommand)]
+    pub command: Command,
+}
+
+#[derive(Subcommand, Debug)]
+pub enum Command {
+    /// Render a scene to a PNG or EXR image.
+    Render(RenderArgs),
+    /// Print a scene's entities, effects manifest, primitive counts and kd-tree statistics.
+    Info(InfoArgs),
+    /// Print RMSE, relMSE and the maximum error between an image and a reference (B).
+    Compare { a: PathBuf, b: PathBuf },
+}
+
+#[derive(Args, Debug)]
+pub struct RenderArgs {
+    pub scene: PathBuf,
+    /// Output image, .png (sRGB 8-bit) or .exr (32-bit float); default: the scene's name .png.
+    #[arg(short, long)]
+    pub output: Option<PathBuf>,
+    /// Samples per pixel (overrides render.spp).
+    #[arg(long)]
+    pub spp: Option<u32>,
+    /// Random seed (overrides render.seed).
+    #[arg(long)]
+    pub seed: Option<u64>,
+    /// Worker threads (default: all cores).
+    #[arg(long)]
+    pub threads: Option<usize>,
+    /// Image size WxH (overrides render.width and render.height).
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+    /// Stop between whole passes after this many seconds; every pixel keeps the same count.
+    #[arg(long)]
+    pub time_limit: Option<f64>,
+    /// Override a scene value by path, e.g. render.integrator.fresnel=Schlick.
+    #[arg(long = "set", value_parser = parse_key_value)]
+    pub set: Vec<(String, String)>,
+    /// Simulate an effect the scene does not need (lens, motion, spectral, media, ...).
+    #[arg(long)]
+    pub force: Vec<String>,
+    /// First sample index per pixel, so separately rendered sample ranges never overlap.
+    #[arg(long, default_value_t = 0)]
+    pub sample_offset: u32,
+    /// PNG exposure in stops.
+    #[arg(long, default_value_t = 0.0)]
+    pub exposure: f32,
+    /// Use the per-path reference integrator instead of the wavefront one.
+    #[arg(long, hide = true)]
+    pub reference: bool,
+    /// Print render statistics.
+    #[arg(long)]
+    pub stats: bool,
+    /// No progress output.
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+#[derive(Args, Debug)]
+pub struct InfoArgs {
+    pub scene: PathBuf,
+    #[arg(long = "set", value_parser = parse_key_value)]
+    pub set: Vec<(String, String)>,
+    #[arg(long)]
+    pub force: Vec<String>,
+}
+
+/// A command-line failure: one readable line.
+#[derive(Debug)]
+pub struct CliError(pub String);
+
+impl fmt::Display for CliError {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(&self.0)
+    }
+}
+
+impl std::error::Error for CliError {}
+
+macro_rules! from_error {
+    ($($t:ty),*) => {$(
+        impl From<$t> for CliError {
+            fn from(e: $t) -> Self {
+                CliError(e.to_string())
+            }
+        }
+    )*};
+}
+from_error!(scene_file::SceneError, film::FilmError);
+
+fn parse_size(s: &str) -> Result<(u32, u32), String> {
+    let (w, h) = s
+        .split_once(['x', 'X'])
+        .ok_or_else(|| format!("expected WxH, e.g. 640x480, got '{s}'"))?;
+    let p = |v: &str| -> Result<u32, String> {
+        let n: u32 = v
+            .trim()
+            .parse()
+            .map_err(|_| format!("expected WxH with whole numbers, got '{s}'"))?;
+        if (1..=65536).contains(&n) {
+            Ok(n)
+        } else {
+            Err(format!("width and height must be in 1..=65536 pixels, got '{s}'"))
+        }
+    };
+    Ok((p(w)?, p(h)?))
+}
+
+fn parse_key_value(s: &str) -> Result<(String, String), String> {
+    let (k, v) = s
+        .split_once('=')
+        .ok_or_else(|| format!("expected KEY=VALUE, got '{s}'"))?;
+    Ok((k.trim().to_string(), v.trim().to_string()))
+}
+
+/// Runs a parsed command line.
+pub fn run(cli: Cli) -> Result<(), CliError> {
+    match cli.command {
+        Command::Render(a) => render(a),
+        Command::Info(a) => info(a),
+        Command::Compare { a, b } => {
+            let m = film::compare_files(&a, &b)?;
+            println!("RMSE: {:.6e}", m.rmse);
+            println!("relMSE: {:.6e}", m.relmse);
+            println!("max error: {:.6e}", m.max_abs);
+            Ok(())
+        }
+    }
+}
+
+/// Loads a scene with the command line's overrides folded into `--set` form.
+fn load_scene(path: &Path, set: &[(String, String)], extra: &[(String, String)]) -> Result<LoadedScene, CliError> {
+    let mut all = set.to_vec();
+    all.extend_from_slice(extra);
+    Ok(scene_file::load(path, &all)?)
+}
+
+fn prepare(scene: &LoadedScene, force: &[String]) -> Result<RenderScene, CliError> {
+    let mut rs = systems::prepare(scene, &KdParams::default());
+    for f in force {
+        let e = Effect::parse(f).ok_or_else(|| {
+            CliError(format!(
+                "--force {f}: unknown effect; valid: {}",
+                Effect::ALL
+                    .iter()
+                    .map(|e| e.name().to_ascii_lowercase())
+                    .collect::<Vec<_>>()
+                    .join(", ")
+            ))
+        })?;
+        rs.effects.force(e).map_err(CliError)?;
+    }
+    Ok(rs)
+}
+
+fn render(a: RenderArgs) -> Result<(), CliError> {
+    let mut extra = Vec::new();
+    if let Some(spp) = a.spp {
+        extra.push(("render.spp".to_string(), spp.to_string()));
+    }
+    if let Some(seed) = a.seed {
+        extra.push(("render.seed".to_string(), seed.to_string()));
+    }
+    if let Some((w, h)) = a.size {
+        extra.push(("render.width".to_string(), w.to_string()));
+        extra.push(("render.height".to_string(), h.to_string()));
+    }
+    if let Some(t) = a.time_limit
+        && !(t.is_finite() && t > 0.0)
+    {
+        return Err(CliError(format!("--time-limit must be a positive number of seconds, got {t}")));
+    }
+    if a.threads == Some(0) {
+        return Err(CliError("--threads must be at least 1".into()));
+    }
+    let scene = load_scene(&a.scene, &a.set, &extra)?;
+    let output = a.output.clone().unwrap_or_else(|| {
+        PathBuf::from(format!(
+            "{}.png",
+            a.scene.file_stem().map_or("render".into(), |s| s.to_string_lossy())
+        ))
+    });
+    // Fail on a bad output name before spending time on the render.
+    film::ImageFormat::from_path(&output)?;
+    let rs = prepare(&scene, &a.force)?;
+    let spp = rs.settings.spp;
+    let opts = RenderOptions {
+        sample_offset: a.sample_offset,
+        spp,
+        time_limit: a.time_limit,
+        integrator: if a.reference {
+            Integrator::Reference
+        } else {
+            Integrator::Wavefront
+        },
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(a.threads.unwrap_or(0))
+        .build()
+        .map_err(|e| CliError(format!("cannot start worker threads: {e}")))?;
+    let total = rs.settings.width as u64 * rs.settings.height as u64 * spp as u64;
+    let bar = progress::Progress::new(total, a.quiet);
+    let out = pool.install(|| integrator::render(&rs, &opts, &|n| bar.add(n)));
+    bar.finish();
+    let meta = ImageMeta {
+        spp: out.spp,
+        sample_offset: a.sample_offset as u64,
+        scene_hash: scene.hash,
+    };
+    film::write_image(&output, &out.image(), &meta, &PngOptions { exposure: a.exposure })?;
+    if a.stats {
+        let threads = pool.current_num_threads();
+        let s = &out.stats;
+        let sps = s.samples as f64 / out.seconds.max(1e-9);
+        eprintln!("image: {} ({}x{}, {} spp)", output.display(), out.width, out.height, out.spp);
+        eprintln!("time: {:.3} s on {} threads", out.seconds, threads);
+        eprintln!("samples: {} ({:.0} samples/s, {:.0} samples/s per thread)", s.samples, sps, sps / threads as f64);
+        eprintln!("dropped samples: {}", s.dropped);
+        eprintln!(
+            "rays: {} closest-hit, {} shadow ({:.2} Mrays/s)",
+            s.rays,
+            s.shadow_rays,
+            (s.rays + s.shadow_rays) as f64 / out.seconds.max(1e-9) * 1e-6
+        );
+        let k = rs.accel.stats();
+        eprintln!(
+            "kd-tree: {} primitives, {} nodes, depth {}, {:.2} primitives per leaf, built in {:.3} ms",
+            k.primitives, k.nodes, k.max_depth, k.mean_leaf_prims, rs.accel_seconds * 1e3
+        );
+    } else if !a.quiet {
+        eprintln!("wrote {} ({} spp, {:.2} s)", output.display(), out.spp, out.seconds);
+    }
+    Ok(())
+}
+
+fn info(a: InfoArgs) -> Result<(), CliError> {
+    let scene = load_scene(&a.scene, &a.set, &[])?;
+    let rs = prepare(&scene, &a.force)?;
+    let s = &rs.settings;
+    println!("scene: {}", a.scene.display());
+    println!(
+        "render: {}x{}, {} spp, max depth {}, seed {}, {:?} light sampling, rr depth {}, {:?} Fresnel, {:?} sampler",
+        s.width, s.height, s.spp, s.max_depth, s.seed, s.light_sampling, s.rr_depth, s.fresnel, s.sampler
+    );
+    println!("entities: {}", rs.prims.len());
+    for i in 0..rs.prims.len() {
+        let m = rs.prims.materials[rs.prims.material[i] as usize];
+        println!("  \"{}\": {:?}, {:?}", rs.prims.names[i], rs.prims.kind[i], m);
+    }
+    println!("effects:");
+    for line in rs.effects.to_string().lines() {
+        println!("  {line}");
+    }
+    let counts = rs
+        .prims
+        .counts()
+        .iter()
+        .map(|(k, n)| format!("{n} {k:?}"))
+        .collect::<Vec<_>>()
+        .join(", ");
+    println!("primitives: {} ({counts})", rs.prims.len());
+    println!(
+        "lights: {} ({} area{})",
+        rs.lights.lights.len(),
+        rs.lights.lights.len() - rs.lights.environment.is_some() as usize,
+        if rs.lights.environment.is_some() { ", environment" } else { "" }
+    );
+    let k = rs.accel.stats();
+    println!(
+        "kd-tree: {} nodes ({} leaves, {} empty), depth {}, {:.2} primitives per leaf, {} references, built in {:.3} ms",
+        k.nodes,
+        k.leaves,
+        k.empty_leaves,
+        k.max_depth,
+        k.mean_leaf_prims,
+        k.prim_refs,
+        rs.accel_seconds * 1e3
+    );
+    Ok(())
+}

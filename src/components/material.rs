@@ -1,0 +1,35 @@
+//! `Material`: how a surface scatters or emits.
+//!
+//! ```
+//! # use prism::scene_file::schema::Material;
+//! let m: Material = ron::from_str("Diffuse(albedo: Rgb(0.8, 0.8, 0.8))").unwrap();
+//! # let _ = m;
+//! let m: Material = ron::from_str("Mirror(tint: Rgb(0.9, 0.9, 0.9))").unwrap();
+//! # let _ = m;
+//! let m: Material = ron::from_str("Dielectric(ior: Constant(1.5))").unwrap();
+//! # let _ = m;
+//! let m: Material = ron::from_str("Light(emission: Rgb(17.0, 12.0, 4.0), two_sided: false)").unwrap();
+//! # let _ = m;
+//! ```
+//! A `Light` emits from the side its normal faces (spheres and boxes: outward) unless
+//! `two_sided`; it does not scatter.
+
+use glam::Vec3;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Material {
+    /// Lambertian reflection.
+    Diffuse { albedo: Vec3 },
+    /// Perfect specular reflection.
+    Mirror { tint: Vec3 },
+    /// Smooth glass: Fresnel-weighted reflection and refraction.
+    Dielectric { ior: f32 },
+    /// An area emitter of constant radiance.
+    Light { emission: Vec3, two_sided: bool },
+}
+
+impl Material {
+    pub fn is_emissive(&self) -> bool {
+        matches!(self, Material::Light { emission, .. } if emission.max_element() > 0.0)
+    }
+}

@@ -1,0 +1,33 @@
+//! ECS components: plain data attached to scene entities by `scene_file::load`.
+
+pub mod camera;
+pub mod material;
+pub mod shape;
+
+pub use camera::Camera;
+pub use material::Material;
+pub use shape::Shape;
+
+use glam::Affine3A;
+
+/// The entity's name in the scene file; every error about an entity uses it.
+#[derive(Clone, Debug, PartialEq, Eq)]
+pub struct Name(pub String);
+
+/// Object-to-world placement: scale, then rotation R = Rz·Ry·Rx (degrees), then translation.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Transform {
+    pub to_world: Affine3A,
+    /// The uniform scale factor when the transform is a similarity (rotation and uniform
+    /// scale), which spheres require.
+    pub uniform_scale: Option<f32>,
+}
+
+impl Default for Transform {
+    fn default() -> Self {
+        Self {
+            to_world: Affine3A::IDENTITY,
+            uniform_scale: Some(1.0),
+        }
+    }
+}

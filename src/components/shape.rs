@@ -1,0 +1,40 @@
+//! `Shape`: the geometry of an entity, in object space.
+//!
+//! ```
+//! # use prism::scene_file::schema::Shape;
+//! let s: Shape = ron::from_str("Sphere(center: (0.0, 1.0, 0.0), radius: 1.0)").unwrap();
+//! # let _ = s;
+//! let s: Shape = ron::from_str("Rect(center: (0.0, 3.0, 0.0), u: (0.5, 0.0, 0.0), v: (0.0, 0.0, 0.5))").unwrap();
+//! # let _ = s;
+//! let s: Shape = ron::from_str("Disk(center: (0.0, 0.0, 0.0), normal: (0.0, 1.0, 0.0), radius: 2.0)").unwrap();
+//! # let _ = s;
+//! let s: Shape = ron::from_str("Box(min: (0.0, 0.0, 0.0), max: (1.0, 2.0, 1.0))").unwrap();
+//! # let _ = s;
+//! ```
+//! `Rect` spans `center ± u ± v` (half edges) and faces `normalize(u × v)`; `Box` is closed.
+
+use glam::Vec3;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Shape {
+    Sphere { center: Vec3, radius: f32 },
+    Rect { center: Vec3, u: Vec3, v: Vec3 },
+    Disk { center: Vec3, normal: Vec3, radius: f32 },
+    Box { min: Vec3, max: Vec3 },
+}
+
+impl Shape {
+    pub fn kind_name(&self) -> &'static str {
+        match self {
+            Shape::Sphere { .. } => "Sphere",
+            Shape::Rect { .. } => "Rect",
+            Shape::Disk { .. } => "Disk",
+            Shape::Box { .. } => "Box",
+        }
+    }
+
+    /// Closed shapes have an inside (media and dielectrics rely on it).
+    pub fn is_closed(&self) -> bool {
+        matches!(self, Shape::Sphere { .. } | Shape::Box { .. })
+    }
+}

@@ -1,0 +1,129 @@
+//! Axis-aligned bounding boxes.
+
+use super::Ray;
+use glam::Vec3;
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Aabb {
+    pub min: Vec3,
+    pub max: Vec3,
+}
+
+impl Aabb {
+    /// The empty box: the identity of `union`.
+    pub const EMPTY: Aabb = Aabb {
+        min: Vec3::splat(f32::INFINITY),
+        max: Vec3::splat(f32::NEG_INFINITY),
+    };
+
+    #[inline]
+    pub fn new(a: Vec3, b: Vec3) -> Self {
+        Self {
+            min: a.min(b),
+            max: a.max(b),
+        }
+    }
+
+    #[inline]
+    pub fn from_points(points: &[Vec3]) -> Self {
+        points
+            .iter()
+            .fold(Self::EMPTY, |b, &p| b.union_point(p))
+    }
+
+    #[inline]
+    pub fn union(&self, o: &Aabb) -> Aabb {
+        Aabb {
+            min: self.min.min(o.min),
+            max: self.max.max(o.max),
+        }
+    }
+
+    #[inline]
+    pub fn union_point(&self, p: Vec3) -> Aabb {
+        Aabb {
+            min: self.min.min(p),
+            max: self.max.max(p),
+        }
+    }
+
+    #[inline]
+    pub fn intersection(&self, o: &Aabb) -> Aabb {
+        Aabb {
+            min: self.min.max(o.min),
+            max: self.max.min(o.max),
+        }
+    }
+
+    #[inline]
+    pub fn is_empty(&self) -> bool {
+        self.min.x > self.max.x || self.min.y > self.max.y || self.min.z > self.max.z
+    }
+
+    #[inline]
+    pub fn diagonal(&self) -> Vec3 {
+        self.max - self.min
+    }
+
+    #[inline]
+    pub fn center(&self) -> Vec3 {
+        (self.min + self.max) * 0.5
+    }
+
+    #[inline]
+    pub fn surface_area(&self) -> f32 {
+        if self.is_empty() {
+            return 0.0;
+        }
+        let d = self.diagonal();
+        2.0 * (d.x * d.y + d.y * d.z + d.z * d.x)
+    }
+
+    /// Grows the box by a relative and an absolute margin on every side, so that a
+    /// primitive's rounded bounds still contain every point its intersection can report.
+    #[inline]
+    pub fn padded(&self, rel: f32, abs: f32) -> Aabb {
+        // One margin for all axes, from the largest coordinate: a flat box at 0 on one axis
+        // still gets thickness from the others' magnitude.
+        let m = self.min.abs().max(self.max.abs()).max_element();
+        let pad = Vec3::splat(m * rel + abs);
+        Aabb {
+            min: self.min - pad,
+            max: self.max + pad,
+        }
+    }
+
+    /// Parametric range `[t0, t1]` of `ray` inside the box, clipped to `[0, t_max]`.
+    /// `inv_d` is `1 / ray.d` (infinite components for axis-parallel rays are handled).
+    #[inline]
+    pub fn intersect_p(&self, ray: &Ray, inv_d: Vec3, t_max: f32) -> Option<(f32, f32)> {
+        let mut t0 = 0.0f32;
+        let mut t1 = t_max;
+        for a in 0..3 {
+            let inv = inv_d[a];
+            let mut tn = (self.min[a] - ray.o[a]) * inv;
+            let mut tf = (self.max[a] - ray.o[a]) * inv;
+            if tn > tf {
+                std::mem::swap(&mut tn, &mut tf);
+            }
+            // 0 * inf = NaN for an axis-parallel ray starting on a slab plane: treat as inside.
+            if tn.is_nan() {
+                tn = f32::NEG_INFINITY;
+            }
+            if tf.is_nan() {
+                tf = f32::INFINITY;
+            }
+            // Conservative rounding (pbrt's gamma(3)) keeps grazing rays from slipping past.
+            tf *= 1.0 + 2.0 * GAMMA3;
+            t0 = t0.max(tn);
+            t1 = t1.min(tf);
+            if t0 > t1 {
+                return None;
+            }
+        }
+        Some((t0, t1))
+    }
+}
+
+/// pbrt's γ(3) = 3u / (1 − 3u), u the unit roundoff of f32.
+pub const GAMMA3: f32 = 3.0 * (f32::EPSILON * 0.5) / (1.0 - 3.0 * (f32::EPSILON * 0.5));

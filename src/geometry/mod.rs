@@ -1,0 +1,9 @@
+//! Rays, bounds, robust offsets and the analytic shapes.
+
+pub mod bounds;
+pub mod ray;
+pub mod shapes;
+
+pub use bounds::Aabb;
+pub use ray::{Ray, offset_ray_origin, spawn_ray, spawn_ray_to};
+pub use shapes::{OrientedBox, Planar, ShapeSample, Sphere, SurfacePoint};

@@ -1,0 +1,334 @@
+//! The analytic shapes in the form the hot loop wants: world-space data, intersection that
+//! returns a small record, surface data for the winning hit only, and area-light sampling with
+//! its pdf beside it.
+
+use super::{Aabb, Ray};
+use glam::{Affine3A, Mat3, Vec2, Vec3};
+
+/// Where on a surface a ray hit, and the frame there.
+#[derive(Clone, Copy, Debug)]
+pub struct SurfacePoint {
+    /// Hit point, re-projected onto the surface to keep its error small.
+    pub p: Vec3,
+    /// Unit geometric normal: outward for closed shapes, `normalize(u × v)` for planar ones.
+    pub n: Vec3,
+}
+
+/// A point sampled on an emitter, as seen from a reference point.
+#[derive(Clone, Copy, Debug)]
+pub struct ShapeSample {
+    pub p: Vec3,
+    pub n: Vec3,
+    /// Density with respect to solid angle at the reference point.
+    pub pdf: f32,
+}
+
+/// Bounds padding: the relative error of a few float operations on the coordinates, so the
+/// kd-tree never culls a hit the exact surface has.
+const PAD_REL: f32 = 4.0 * f32::EPSILON;
+
+#[inline]
+fn solid_angle_pdf(pdf_area: f32, ref_p: Vec3, p: Vec3, n: Vec3) -> f32 {
+    let d = p - ref_p;
+    let dist2 = d.length_squared();
+    let cos = n.dot(d).abs() / dist2.sqrt();
+    if cos <= 0.0 || dist2 <= 0.0 {
+        0.0
+    } else {
+        pdf_area * dist2 / cos
+    }
+}
+
+/// A sphere in world space. Spheres take similarity transforms only, so centre and radius
+/// describe them fully.
+#[derive(Clone, Copy, Debug)]
+pub struct Sphere {
+    pub center: Vec3,
+    pub radius: f32,
+}
+
+impl Sphere {
+    pub fn bounds(&self) -> Aabb {
+        Aabb::new(self.center - self.radius, self.center + self.radius).padded(PAD_REL, 0.0)
+    }
+
+    /// Nearest `t` in (0, t_max). The discriminant is formed from the distance between the
+    /// centre and the ray's closest point (Haines et al., Ray Tracing Gems ch. 7), which stays
+    /// accurate for distant and tangent rays, and the roots use the stable quadratic form.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<f32> {
+        let f = ray.o - self.center;
+        let a = ray.d.length_squared();
+        let b = f.dot(ray.d);
+        let c = f.length_squared() - self.radius * self.radius;
+        let l = f - (b / a) * ray.d;
+        let disc = a * (self.radius * self.radius - l.length_squared());
+        if disc < 0.0 {
+            return None;
+        }
+        let q = -b - b.signum() * disc.sqrt();
+        let (mut t0, mut t1) = (c / q, q / a);
+        if t0 > t1 {
+            std::mem::swap(&mut t0, &mut t1);
+        }
+        if t0 > 0.0 && t0 < t_max {
+            Some(t0)
+        } else if t1 > 0.0 && t1 < t_max {
+            Some(t1)
+        } else {
+            None
+        }
+    }
+
+    #[inline]
+    pub fn surface(&self, ray: &Ray, t: f32) -> SurfacePoint {
+        let rel = ray.at(t) - self.center;
+        let n = rel.normalize_or(Vec3::Y);
+        SurfacePoint {
+            p: self.center + n * self.radius,
+            n,
+        }
+    }
+
+    pub fn area(&self) -> f32 {
+        4.0 * std::f32::consts::PI * self.radius * self.radius
+    }
+
+    /// Samples the cone of directions the sphere subtends from `ref_p` (uniform in solid
+    /// angle); from inside, uniformly by area.
+    pub fn sample(&self, ref_p: Vec3, u: Vec2) -> Option<ShapeSample> {
+        let dc2 = (ref_p - self.center).length_squared();
+        let r2 = self.radius * self.radius;
+        if dc2 <= r2 * 1.0001 {
+            let n = crate::sampling::square_to_uniform_sphere(u);
+            let p = self.center + n * self.radius;
+            let pdf = solid_angle_pdf(1.0 / self.area(), ref_p, p, n);
+            return (pdf > 0.0 && pdf.is_finite()).then_some(ShapeSample { p, n, pdf });
+        }
+        let dc = dc2.sqrt();
+        let sin2_max = r2 / dc2;
+        let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
+        let w = (self.center - ref_p) / dc;
+        let local = crate::sampling::square_to_uniform_cone(u, cos_max);
+        let (t, b) = crate::sampling::coordinate_system(w);
+        let dir = t * local.x + b * local.y + w * local.z;
+        // The point on the sphere along `dir`: the near root of the ray–sphere quadratic,
+        // clamped to the tangent point when rounding puts the direction just outside.
+        let bq = (ref_p - self.center).dot(dir);
+        let disc = (bq * bq - (dc2 - r2)).max(0.0);
+        let tq = -bq - disc.sqrt();
+        let p_raw = ref_p + dir * tq;
+        let n = (p_raw - self.center).normalize_or(-w);
+        let pdf = crate::sampling::uniform_cone_pdf(cos_max);
+        Some(ShapeSample {
+            p: self.center + n * self.radius,
+            n,
+            pdf,
+        })
+    }
+
+    /// Solid-angle density of `sample` for a direction from `ref_p` that hits at `p`.
+    pub fn pdf(&self, ref_p: Vec3, p: Vec3, n: Vec3) -> f32 {
+        let dc2 = (ref_p - self.center).length_squared();
+        let r2 = self.radius * self.radius;
+        if dc2 <= r2 * 1.0001 {
+            return solid_angle_pdf(1.0 / self.area(), ref_p, p, n);
+        }
+        let cos_max = (1.0 - r2 / dc2).max(0.0).sqrt();
+        crate::sampling::uniform_cone_pdf(cos_max)
+    }
+}
+
+/// A parallelogram (`Rect`) or an ellipse (`Disk`) in world space: `center + α u + β v` with
+/// |α|, |β| ≤ 1 or α² + β² ≤ 1. An affine transform maps either onto the same form, so both
+/// are baked to world space and never transform rays.
+#[derive(Clone, Copy, Debug)]
+pub struct Planar {
+    pub center: Vec3,
+    pub u: Vec3,
+    pub v: Vec3,
+    /// Unit normal `normalize(u × v)`.
+    pub n: Vec3,
+    /// `(u × v) / |u × v|²`: turns a point's offset into its (α, β) coordinates.
+    w: Vec3,
+    area: f32,
+}
+
+impl Planar {
+    pub fn new(center: Vec3, u: Vec3, v: Vec3, disk: bool) -> Self {
+        let nn = u.cross(v);
+        let len2 = nn.length_squared();
+        let area = len2.sqrt() * if disk { std::f32::consts::PI } else { 4.0 };
+        Self {
+            center,
+            u,
+            v,
+            n: nn / len2.sqrt(),
+            w: nn / len2,
+            area,
+        }
+    }
+
+    pub fn bounds(&self, disk: bool) -> Aabb {
+        let ext = if disk {
+            // An ellipse's extent along each axis is |(u_a, v_a)|.
+            Vec3::new(
+                self.u.x.hypot(self.v.x),
+                self.u.y.hypot(self.v.y),
+                self.u.z.hypot(self.v.z),
+            )
+        } else {
+            self.u.abs() + self.v.abs()
+        };
+        Aabb::new(self.center - ext, self.center + ext).padded(PAD_REL, 0.0)
+    }
+
+    /// Nearest hit in (0, t_max) with its (α, β) coordinates.
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f32, disk: bool) -> Option<(f32, f32, f32)> {
+        let denom = self.n.dot(ray.d);
+        let t = self.n.dot(self.center - ray.o) / denom;
+        // A ray in the plane (denom 0) gives an infinite or NaN t and fails here.
+        if !(t > 0.0 && t < t_max) {
+            return None;
+        }
+        let rel = ray.at(t) - self.center;
+        let a = self.w.dot(rel.cross(self.v));
+        let b = self.w.dot(self.u.cross(rel));
+        let inside = if disk {
+            a * a + b * b <= 1.0
+        } else {
+            a.abs() <= 1.0 && b.abs() <= 1.0
+        };
+        inside.then_some((t, a, b))
+    }
+
+    #[inline]
+    pub fn surface(&self, a: f32, b: f32) -> SurfacePoint {
+        SurfacePoint {
+            p: self.center + a * self.u + b * self.v,
+            n: self.n,
+        }
+    }
+
+    pub fn area(&self) -> f32 {
+        self.area
+    }
+
+    /// Uniform by area. (Solid-angle sampling of spherical rectangles only applies to true
+    /// rectangles; affine transforms make general parallelograms and ellipses, so area
+    /// sampling serves every planar emitter.)
+    pub fn sample(&self, ref_p: Vec3, u: Vec2, disk: bool) -> Option<ShapeSample> {
+        let (a, b) = if disk {
+            let d = crate::sampling::square_to_uniform_disk_concentric(u);
+            (d.x, d.y)
+        } else {
+            (2.0 * u.x - 1.0, 2.0 * u.y - 1.0)
+        };
+        let p = self.center + a * self.u + b * self.v;
+        let pdf = solid_angle_pdf(1.0 / self.area, ref_p, p, self.n);
+        (pdf > 0.0 && pdf.is_finite()).then_some(ShapeSample { p, n: self.n, pdf })
+    }
+
+    pub fn pdf(&self, ref_p: Vec3, p: Vec3) -> f32 {
+        solid_angle_pdf(1.0 / self.area, ref_p, p, self.n)
+    }
+}
+
+/// A box placed by an affine transform (rotated, sheared or scaled): intersected in object
+/// space with a slab test.
+#[derive(Clone, Copy, Debug)]
+pub struct OrientedBox {
+    pub min: Vec3,
+    pub max: Vec3,
+    pub to_world: Affine3A,
+    pub to_object: Affine3A,
+    /// Inverse transpose of the linear part: carries normals to world space.
+    pub normal_matrix: Mat3,
+}
+
+impl OrientedBox {
+    pub fn new(min: Vec3, max: Vec3, to_world: Affine3A) -> Self {
+        let to_object = to_world.inverse();
+        let normal_matrix = Mat3::from(to_object.matrix3).transpose();
+        Self {
+            min,
+            max,
+            to_world,
+            to_object,
+            normal_matrix,
+        }
+    }
+
+    pub fn bounds(&self) -> Aabb {
+        let mut b = Aabb::EMPTY;
+        for i in 0..8 {
+            let c = Vec3::new(
+                if i & 1 == 0 { self.min.x } else { self.max.x },
+                if i & 2 == 0 { self.min.y } else { self.max.y },
+                if i & 4 == 0 { self.min.z } else { self.max.z },
+            );
+            b = b.union_point(self.to_world.transform_point3(c));
+        }
+        b.padded(PAD_REL * 4.0, 0.0)
+    }
+
+    #[inline]
+    fn object_ray(&self, ray: &Ray) -> Ray {
+        Ray::new(
+            self.to_object.transform_point3(ray.o),
+            self.to_object.transform_vector3(ray.d),
+        )
+    }
+
+    #[inline]
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<f32> {
+        let r = self.object_ray(ray);
+        let inv = r.d.recip();
+        let t0 = (self.min - r.o) * inv;
+        let t1 = (self.max - r.o) * inv;
+        let tn = t0.min(t1);
+        let tf = t0.max(t1);
+        // NaN from 0·∞ (an axis-parallel ray on a slab plane) is dropped by max/min.
+        let t_near = tn.x.max(tn.y).max(tn.z);
+        let t_far = tf.x.min(tf.y).min(tf.z);
+        if t_near > t_far {
+            return None;
+        }
+        if t_near > 0.0 && t_near < t_max {
+            Some(t_near)
+        } else if t_near <= 0.0 && t_far > 0.0 && t_far < t_max {
+            Some(t_far)
+        } else {
+            None
+        }
+    }
+
+    pub fn surface(&self, ray: &Ray, t: f32) -> SurfacePoint {
+        let r = self.object_ray(ray);
+        let mut p = r.at(t);
+        // The face is the one the point lies closest to, relative to the box size; snapping
+        // the point onto it removes the error along the normal.
+        let size = (self.max - self.min).max(Vec3::splat(f32::MIN_POSITIVE));
+        let mut best = (f32::INFINITY, 0usize, 0.0f32, 1.0f32);
+        for a in 0..3 {
+            let dmin = (p[a] - self.min[a]).abs() / size[a];
+            let dmax = (p[a] - self.max[a]).abs() / size[a];
+            if dmin < best.0 {
+                best = (dmin, a, self.min[a], -1.0);
+            }
+            if dmax < best.0 {
+                best = (dmax, a, self.max[a], 1.0);
+            }
+        }
+        let (_, axis, plane, sign) = best;
+        p[axis] = plane;
+        p = p.clamp(self.min, self.max);
+        let mut n_obj = Vec3::ZERO;
+        n_obj[axis] = sign;
+        SurfacePoint {
+            p: self.to_world.transform_point3(p),
+            n: (self.normal_matrix * n_obj).normalize(),
+        }
+    }
+}

@@ -1,0 +1,291 @@
+//! One path vertex at a time: camera rays and the shading step shared by the wavefront
+//! stages and the reference integrator, so both simulate exactly the same physics.
+
+use super::bsdf::{fresnel_dielectric, fresnel_schlick, reflect, refract};
+use crate::components::Material;
+use crate::geometry::{Ray, offset_ray_origin, spawn_ray_to};
+use crate::sampling::{self, Sampler};
+use crate::scene_file::schema::{Fresnel, LightSampling};
+use crate::systems::{Hit, RenderScene, primitives::emitted};
+use glam::{Vec2, Vec3};
+
+// Sample dimensions. The layout is fixed whatever the effect set, so an absent effect never
+// shifts the dimensions of the others: a scene renders the same image with or without code
+// for effects it does not use.
+pub const DIM_FILM: u32 = 0;
+pub const DIM_LENS: u32 = 2;
+pub const DIM_TIME: u32 = 4;
+pub const DIM_WAVELENGTH: u32 = 5;
+pub const DIM_BOUNCE: u32 = 8;
+/// Dimensions each scattering event may use: light choice (1), light point (2), lobe (1),
+/// direction (2), Russian roulette (1), and one reserved.
+pub const DIMS_PER_BOUNCE: u32 = 8;
+
+/// Per-render constants of the shading step, hoisted out of the per-ray loop.
+#[derive(Clone, Copy)]
+pub struct Ctx<'a> {
+    pub scene: &'a RenderScene,
+    pub sampler: Sampler,
+    pub width: u32,
+    pub max_depth: u32,
+    pub rr_depth: u32,
+    pub nee: bool,
+    pub schlick: bool,
+    pub lens: bool,
+}
+
+impl<'a> Ctx<'a> {
+    pub fn new(scene: &'a RenderScene, lens: bool) -> Self {
+        let s = &scene.settings;
+        Ctx {
+            scene,
+            sampler: Sampler::new(
+                match s.sampler {
+                    crate::scene_file::schema::SamplerChoice::Sobol => sampling::SamplerKind::Sobol,
+                    crate::scene_file::schema::SamplerChoice::Independent => {
+                        sampling::SamplerKind::Independent
+                    }
+                },
+                s.seed,
+            ),
+            width: s.width,
+            max_depth: s.max_depth,
+            rr_depth: s.rr_depth,
+            nee: s.light_sampling == LightSampling::Nee && !scene.lights.is_empty(),
+            schlick: s.fresnel == Fresnel::Schlick,
+            lens,
+        }
+    }
+}
+
+/// The state a path carries between vertices.
+#[derive(Clone, Copy, Debug)]
+pub struct PathState {
+    pub ray: Ray,
+    pub beta: Vec3,
+    /// Radiance gathered so far.
+    pub l: Vec3,
+    /// Product of squared relative IORs crossed; Russian roulette divides it out of the
+    /// throughput so entering dense glass does not kill paths.
+    pub eta_scale: f32,
+    pub depth: u32,
+    pub specular: bool,
+    /// Solid-angle pdf of the direction that reached this vertex (for MIS on emitters).
+    pub prev_pdf: f32,
+    pub prev_p: Vec3,
+    pub time: f32,
+    pub pixel: u32,
+    pub sample: u32,
+    pub alive: bool,
+}
+
+/// A shadow ray whose contribution lands on the path if nothing blocks it.
+#[derive(Clone, Copy, Debug)]
+pub struct ShadowRequest {
+    pub ray: Ray,
+    pub t_max: f32,
+    pub contrib: Vec3,
+}
+
+#[inline]
+fn power_heuristic(a: f32, b: f32) -> f32 {
+    let (a2, b2) = (a * a, b * b);
+    if a2 + b2 == 0.0 { 0.0 } else { a2 / (a2 + b2) }
+}
+
+/// Starts the path of sample `index` of pixel (x, y): film position importance-sampled from
+/// a tent filter of radius one pixel, a lens position when the LENS effect is on, a time when
+/// MOTION is on.
+#[inline]
+pub fn camera_ray<const MOTION: bool>(ctx: &Ctx, x: u32, y: u32, index: u32) -> PathState {
+    let cam = &ctx.scene.camera;
+    let pixel = y * ctx.width + x;
+    let u = ctx.sampler.get_2d(pixel, index, DIM_FILM);
+    let fx = x as f32 + 0.5 + sampling::sample_tent(u.x);
+    let fy = y as f32 + 0.5 + sampling::sample_tent(u.y);
+    let s = &ctx.scene.settings;
+    let sx = 2.0 * fx / s.width as f32 - 1.0;
+    let sy = 1.0 - 2.0 * fy / s.height as f32;
+    let dir = cam.forward + cam.right * (sx * cam.half.x) + cam.up * (sy * cam.half.y);
+    let mut ray = Ray::new(cam.origin, dir.normalize());
+    if ctx.lens {
+        let ul = ctx.sampler.get_2d(pixel, index, DIM_LENS);
+        let lp = lens_point(ul, cam.blades) * cam.aperture_radius;
+        let o = cam.origin + cam.right * lp.x + cam.up * lp.y;
+        // `dir` has unit length along `forward`, so this is the point on the focal plane.
+        let focus = cam.origin + dir * cam.focus_distance;
+        ray = Ray::new(o, (focus - o).normalize());
+    }
+    let time = if MOTION {
+        let (open, close) = ctx.scene.shutter;
+        open + (close - open) * ctx.sampler.get_1d(pixel, index, DIM_TIME)
+    } else {
+        0.0
+    };
+    PathState {
+        ray,
+        beta: Vec3::ONE,
+        l: Vec3::ZERO,
+        eta_scale: 1.0,
+        depth: 0,
+        specular: false,
+        prev_pdf: 0.0,
+        prev_p: ray.o,
+        time,
+        pixel,
+        sample: index,
+        alive: true,
+    }
+}
+
+/// A point on the unit aperture: a disc, or a regular polygon with `blades` sides.
+#[inline]
+pub fn lens_point(u: Vec2, blades: u32) -> Vec2 {
+    if blades < 3 {
+        return sampling::square_to_uniform_disk_concentric(u);
+    }
+    // Pick one of the polygon's equal triangles, reuse the rest of u.x inside it.
+    let n = blades as f32;
+    let k = (u.x * n).floor().min(n - 1.0);
+    let ux = u.x * n - k;
+    let a0 = std::f32::consts::TAU * k / n;
+    let a1 = std::f32::consts::TAU * (k + 1.0) / n;
+    let b = sampling::square_to_uniform_triangle(Vec2::new(ux, u.y));
+    let p0 = Vec2::new(a0.cos(), a0.sin());
+    let p1 = Vec2::new(a1.cos(), a1.sin());
+    p0 * b.x + p1 * b.y
+}
+
+/// Processes the vertex where `s.ray` ends: adds emission found there (MIS-weighted), then
+/// either ends the path or scatters it, returning a shadow ray for next-event estimation.
+#[inline]
+pub fn shade(ctx: &Ctx, s: &mut PathState, hit: Option<Hit>) -> Option<ShadowRequest> {
+    let scene = ctx.scene;
+    let lights = &scene.lights;
+    let wo = -s.ray.d;
+    let mis_emitter = |s: &PathState, pdf_light: f32| -> f32 {
+        if s.depth == 0 || s.specular || !ctx.nee {
+            1.0
+        } else {
+            power_heuristic(s.prev_pdf, pdf_light)
+        }
+    };
+    let Some(hit) = hit else {
+        if scene.environment != Vec3::ZERO {
+            let w = mis_emitter(s, lights.pdf_environment());
+            s.l += s.beta * scene.environment * w;
+        }
+        s.alive = false;
+        return None;
+    };
+    let prims = &scene.prims;
+    let sp = prims.surface(&s.ray, &hit);
+    let material = prims.materials[prims.material[hit.prim as usize] as usize];
+    if let Material::Light { .. } = material {
+        let le = emitted(&material, sp.n, wo);
+        if le != Vec3::ZERO {
+            let w = if s.depth == 0 || s.specular || !ctx.nee {
+                1.0
+            } else {
+                mis_emitter(s, lights.pdf_area(prims, hit.prim, s.prev_p, sp.p, sp.n))
+            };
+            s.l += s.beta * le * w;
+        }
+        // Emitters absorb what they do not emit.
+        s.alive = false;
+        return None;
+    }
+    if s.depth >= ctx.max_depth {
+        s.alive = false;
+        return None;
+    }
+    let dim = DIM_BOUNCE + s.depth * DIMS_PER_BOUNCE;
+    let (pixel, index) = (s.pixel, s.sample);
+    s.depth += 1;
+    // Surfaces scatter on both sides: work in the frame facing the incoming ray.
+    let nf = if sp.n.dot(wo) < 0.0 { -sp.n } else { sp.n };
+    let mut shadow = None;
+    match material {
+        Material::Diffuse { albedo } => {
+            if ctx.nee {
+                let u_sel = ctx.sampler.get_1d(pixel, index, dim);
+                let u_l = ctx.sampler.get_2d(pixel, index, dim + 1);
+                if let Some(ls) = lights.sample(prims, sp.p, u_sel, u_l) {
+                    let cos = ls.wi.dot(nf);
+                    if cos > 0.0 {
+                        let bsdf_pdf = cos * std::f32::consts::FRAC_1_PI;
+                        let f = albedo * std::f32::consts::FRAC_1_PI * cos;
+                        let w = power_heuristic(ls.pdf, bsdf_pdf);
+                        let contrib = s.beta * f * ls.radiance * (w / ls.pdf);
+                        if contrib != Vec3::ZERO {
+                            let (ray, t_max) = match ls.point {
+                                Some((q, nq)) => spawn_ray_to(sp.p, nf, q, nq),
+                                None => (Ray::new(offset_ray_origin(sp.p, nf), ls.wi), f32::INFINITY),
+                            };
+                            shadow = Some(ShadowRequest {
+                                ray,
+                                t_max,
+                                contrib,
+                            });
+                        }
+                    }
+                }
+            }
+            let u = ctx.sampler.get_2d(pixel, index, dim + 4);
+            let local = sampling::square_to_cosine_hemisphere(u);
+            let (t, b) = sampling::coordinate_system(nf);
+            let wi = (t * local.x + b * local.y + nf * local.z).normalize();
+            s.beta *= albedo;
+            s.prev_pdf = sampling::cosine_hemisphere_pdf(local.z);
+            s.specular = false;
+            s.ray = Ray::new(offset_ray_origin(sp.p, nf), wi);
+        }
+        Material::Mirror { tint } => {
+            s.beta *= tint;
+            s.specular = true;
+            s.ray = Ray::new(offset_ray_origin(sp.p, nf), reflect(wo, nf));
+        }
+        Material::Dielectric { ior } => {
+            // The geometric normal points out of a closed shape: entering when wo is on
+            // its side.
+            let eta = if sp.n.dot(wo) > 0.0 { ior } else { 1.0 / ior };
+            let cos_i = wo.dot(nf);
+            let r = if ctx.schlick {
+                fresnel_schlick(cos_i, eta)
+            } else {
+                fresnel_dielectric(cos_i, eta)
+            };
+            let u = ctx.sampler.get_1d(pixel, index, dim + 3);
+            s.specular = true;
+            match refract(wo, nf, eta) {
+                Some(wt) if u >= r => {
+                    // Radiance is compressed by 1/η² crossing into a denser medium.
+                    s.beta /= eta * eta;
+                    s.eta_scale *= eta * eta;
+                    s.ray = Ray::new(offset_ray_origin(sp.p, -nf), wt);
+                }
+                _ => {
+                    s.ray = Ray::new(offset_ray_origin(sp.p, nf), reflect(wo, nf));
+                }
+            }
+        }
+        Material::Light { .. } => unreachable!("handled above"),
+    }
+    s.prev_p = sp.p;
+    // Russian roulette on the throughput with the IOR compression removed.
+    if s.depth >= ctx.rr_depth {
+        let rr = (s.beta * s.eta_scale).max_element();
+        if rr < 1.0 {
+            let q = (1.0 - rr).max(0.0);
+            if ctx.sampler.get_1d(pixel, index, dim + 6) < q {
+                s.alive = false;
+                return shadow;
+            }
+            s.beta /= 1.0 - q;
+        }
+    }
+    if s.beta == Vec3::ZERO {
+        s.alive = false;
+    }
+    shadow
+}

@@ -1,0 +1,33 @@
+//! The reference integrator: one path at a time, the plainest loop over the same camera,
+//! shading and light sampling as the wavefront stages. Tests compare the two; benches show
+//! what batching buys.
+
+use super::path::{Ctx, camera_ray, shade};
+use super::{RenderStats, Tile};
+
+pub fn render_tile<const MOTION: bool>(
+    ctx: &Ctx,
+    tile: &Tile,
+    s0: u32,
+    s1: u32,
+    film: &mut [[f64; 3]],
+    stats: &mut RenderStats,
+) {
+    for p in 0..tile.pixels() {
+        let (x, y) = tile.pixel(p);
+        for k in s0..s1 {
+            let mut s = camera_ray::<MOTION>(ctx, x, y, k);
+            while s.alive {
+                let hit = ctx.scene.intersect(&s.ray, f32::INFINITY);
+                stats.rays += 1;
+                if let Some(r) = shade(ctx, &mut s, hit) {
+                    stats.shadow_rays += 1;
+                    if !ctx.scene.occluded(&r.ray, r.t_max) {
+                        s.l += r.contrib;
+                    }
+                }
+            }
+            super::accumulate(film, tile, ctx.width, s.pixel, s.l, stats);
+        }
+    }
+}

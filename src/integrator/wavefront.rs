@@ -1,0 +1,224 @@
+//! The wavefront integrator: per tile, structure-of-arrays queues pushed through named stages.
+//!
+//! ```text
+//! generate → intersect → shade (emission, scattering, light samples) → shadow → compact
+//!     ↑__________________________ refill when fewer than half are live ______|
+//! ```
+//! Queues are allocated once per worker and reused for every tile: no allocation per ray.
+
+use super::path::{Ctx, PathState, ShadowRequest, camera_ray, shade};
+use super::{RenderStats, Tile};
+use crate::geometry::Ray;
+use crate::systems::Hit;
+use glam::Vec3;
+
+/// Live path records, one field per array.
+pub struct RayQueue {
+    len: usize,
+    o: Vec<Vec3>,
+    d: Vec<Vec3>,
+    beta: Vec<Vec3>,
+    l: Vec<Vec3>,
+    eta_scale: Vec<f32>,
+    depth: Vec<u32>,
+    specular: Vec<bool>,
+    prev_pdf: Vec<f32>,
+    prev_p: Vec<Vec3>,
+    time: Vec<f32>,
+    pixel: Vec<u32>,
+    sample: Vec<u32>,
+    alive: Vec<bool>,
+}
+
+impl RayQueue {
+    fn new(cap: usize) -> Self {
+        Self {
+            len: 0,
+            o: vec![Vec3::ZERO; cap],
+            d: vec![Vec3::ZERO; cap],
+            beta: vec![Vec3::ZERO; cap],
+            l: vec![Vec3::ZERO; cap],
+            eta_scale: vec![0.0; cap],
+            depth: vec![0; cap],
+            specular: vec![false; cap],
+            prev_pdf: vec![0.0; cap],
+            prev_p: vec![Vec3::ZERO; cap],
+            time: vec![0.0; cap],
+            pixel: vec![0; cap],
+            sample: vec![0; cap],
+            alive: vec![false; cap],
+        }
+    }
+
+    fn cap(&self) -> usize {
+        self.o.len()
+    }
+
+    #[inline]
+    fn load(&self, i: usize) -> PathState {
+        PathState {
+            ray: Ray::new(self.o[i], self.d[i]),
+            beta: self.beta[i],
+            l: self.l[i],
+            eta_scale: self.eta_scale[i],
+            depth: self.depth[i],
+            specular: self.specular[i],
+            prev_pdf: self.prev_pdf[i],
+            prev_p: self.prev_p[i],
+            time: self.time[i],
+            pixel: self.pixel[i],
+            sample: self.sample[i],
+            alive: self.alive[i],
+        }
+    }
+
+    #[inline]
+    fn store(&mut self, i: usize, s: &PathState) {
+        self.o[i] = s.ray.o;
+        self.d[i] = s.ray.d;
+        self.beta[i] = s.beta;
+        self.l[i] = s.l;
+        self.eta_scale[i] = s.eta_scale;
+        self.depth[i] = s.depth;
+        self.specular[i] = s.specular;
+        self.prev_pdf[i] = s.prev_pdf;
+        self.prev_p[i] = s.prev_p;
+        self.time[i] = s.time;
+        self.pixel[i] = s.pixel;
+        self.sample[i] = s.sample;
+        self.alive[i] = s.alive;
+    }
+}
+
+/// Shadow rays of the current step and the path slot each one serves.
+struct ShadowQueue {
+    len: usize,
+    o: Vec<Vec3>,
+    d: Vec<Vec3>,
+    t_max: Vec<f32>,
+    contrib: Vec<Vec3>,
+    slot: Vec<u32>,
+}
+
+impl ShadowQueue {
+    fn new(cap: usize) -> Self {
+        Self {
+            len: 0,
+            o: vec![Vec3::ZERO; cap],
+            d: vec![Vec3::ZERO; cap],
+            t_max: vec![0.0; cap],
+            contrib: vec![Vec3::ZERO; cap],
+            slot: vec![0; cap],
+        }
+    }
+
+    #[inline]
+    fn push(&mut self, r: &ShadowRequest, slot: usize) {
+        let i = self.len;
+        self.o[i] = r.ray.o;
+        self.d[i] = r.ray.d;
+        self.t_max[i] = r.t_max;
+        self.contrib[i] = r.contrib;
+        self.slot[i] = slot as u32;
+        self.len += 1;
+    }
+}
+
+/// One worker's reusable queues.
+pub struct Queues {
+    rays: RayQueue,
+    hits: Vec<Option<Hit>>,
+    shadow: ShadowQueue,
+}
+
+/// Rays per queue: small enough that a queue's hot fields stay in L2.
+pub const QUEUE_CAPACITY: usize = 2048;
+
+impl Queues {
+    pub fn new(cap: usize) -> Self {
+        Self {
+            rays: RayQueue::new(cap),
+            hits: vec![None; cap],
+            shadow: ShadowQueue::new(cap),
+        }
+    }
+}
+
+impl Default for Queues {
+    fn default() -> Self {
+        Self::new(QUEUE_CAPACITY)
+    }
+}
+
+/// Renders samples `s0..s1` of every pixel of `tile`, adding each finished path's radiance to
+/// `film` (the tile's pixels, row-major).
+pub fn render_tile<const MOTION: bool>(
+    ctx: &Ctx,
+    q: &mut Queues,
+    tile: &Tile,
+    s0: u32,
+    s1: u32,
+    film: &mut [[f64; 3]],
+    stats: &mut RenderStats,
+) {
+    let spp = (s1 - s0) as usize;
+    let total = tile.pixels() * spp;
+    let mut next = 0usize;
+    let cap = q.rays.cap();
+    loop {
+        // Stage 1, generate: refill once fewer than half the slots are live.
+        if q.rays.len < cap / 2 {
+            while q.rays.len < cap && next < total {
+                let (p, k) = (next / spp, next % spp);
+                let (x, y) = tile.pixel(p);
+                let s = camera_ray::<MOTION>(ctx, x, y, s0 + k as u32);
+                let i = q.rays.len;
+                q.rays.store(i, &s);
+                q.rays.len += 1;
+                next += 1;
+            }
+        }
+        let n = q.rays.len;
+        if n == 0 {
+            break;
+        }
+        // Stage 2, intersect: closest hits into a small-record queue.
+        for i in 0..n {
+            let ray = Ray::new(q.rays.o[i], q.rays.d[i]);
+            q.hits[i] = ctx.scene.intersect(&ray, f32::INFINITY);
+        }
+        stats.rays += n as u64;
+        // Stages 3–4, emission and shading: one vertex per path, light samples queued.
+        q.shadow.len = 0;
+        for i in 0..n {
+            let mut s = q.rays.load(i);
+            if let Some(r) = shade(ctx, &mut s, q.hits[i]) {
+                q.shadow.push(&r, i);
+            }
+            q.rays.store(i, &s);
+        }
+        // Stage 5, shadow: any-hit tests; unblocked light samples land on their path.
+        let sh = &q.shadow;
+        for j in 0..sh.len {
+            let ray = Ray::new(sh.o[j], sh.d[j]);
+            if !ctx.scene.occluded(&ray, sh.t_max[j]) {
+                q.rays.l[sh.slot[j] as usize] += sh.contrib[j];
+            }
+        }
+        stats.shadow_rays += sh.len as u64;
+        // Stage 6, compact: finished paths go to the film, live ones move down in order.
+        let mut w = 0;
+        for i in 0..n {
+            if q.rays.alive[i] {
+                if w != i {
+                    let s = q.rays.load(i);
+                    q.rays.store(w, &s);
+                }
+                w += 1;
+            } else {
+                super::accumulate(film, tile, ctx.width, q.rays.pixel[i], q.rays.l[i], stats);
+            }
+        }
+        q.rays.len = w;
+    }
+}

@@ -1,0 +1,739 @@
+//! The O(N log N) SAH builder (Wald & Havran 2006).
+//!
+//! An event is one `u64` whose natural order is the sweep order: axis, then position, then
+//! kind (end < planar < start, so that at equal positions the primitives closing there count
+//! as left of the plane and those opening there as right of it), then primitive. A node's
+//! events for all three axes live in one sorted vector, three consecutive runs.
+
+use super::node::KdNode;
+use super::{KdParams, KdPrimitives, KdStats, MAX_DEPTH};
+use crate::geometry::Aabb;
+
+const AXIS_SHIFT: u32 = 62;
+const POS_SHIFT: u32 = 30;
+const KIND_SHIFT: u32 = 28;
+const PRIM_BITS: u32 = 28;
+
+/// Most primitives a tree can hold: the index shares the event word with axis, position and kind.
+pub const MAX_PRIMS: usize = 1 << PRIM_BITS;
+
+const END: u64 = 0;
+const PLANAR: u64 = 1;
+const START: u64 = 2;
+
+/// Maps a float to a `u32` with the same order (for finite values); −0 is folded onto +0 so
+/// that the two compare as the one plane they are.
+#[inline]
+fn ord_bits(x: f32) -> u32 {
+    let b = (x + 0.0).to_bits();
+    if b >> 31 != 0 { !b } else { b | 1 << 31 }
+}
+
+#[inline]
+fn from_ord_bits(k: u32) -> f32 {
+    f32::from_bits(if k >> 31 != 0 { k & !(1 << 31) } else { !k })
+}
+
+#[inline]
+fn event(axis: usize, pos: f32, kind: u64, prim: u32) -> u64 {
+    ((axis as u64) << AXIS_SHIFT)
+        | ((ord_bits(pos) as u64) << POS_SHIFT)
+        | (kind << KIND_SHIFT)
+        | prim as u64
+}
+
+#[inline]
+fn ev_axis(e: u64) -> usize {
+    (e >> AXIS_SHIFT) as usize
+}
+
+#[inline]
+fn ev_pos(e: u64) -> f32 {
+    from_ord_bits((e >> POS_SHIFT) as u32)
+}
+
+#[inline]
+fn ev_kind(e: u64) -> u64 {
+    (e >> KIND_SHIFT) & 3
+}
+
+#[inline]
+fn ev_prim(e: u64) -> u32 {
+    (e & ((1 << PRIM_BITS) - 1)) as u32
+}
+
+/// Axis and position together: events with the same value describe the same plane.
+#[inline]
+fn ev_plane(e: u64) -> u64 {
+    e >> POS_SHIFT
+}
+
+/// Appends the three axes' events of a box (already clipped to its cell).
+fn push_events(out: &mut Vec<u64>, prim: u32, b: &Aabb) {
+    for a in 0..3 {
+        if b.min[a] == b.max[a] {
+            out.push(event(a, b.min[a], PLANAR, prim));
+        } else {
+            out.push(event(a, b.min[a], START, prim));
+            out.push(event(a, b.max[a], END, prim));
+        }
+    }
+}
+
+/// The primitives of a node: each has exactly one start or planar event on axis 0, which
+/// comes first in the list.
+fn node_prims(events: &[u64]) -> impl Iterator<Item = u32> + '_ {
+    events
+        .iter()
+        .take_while(|&&e| ev_axis(e) == 0)
+        .filter(|&&e| ev_kind(e) != END)
+        .map(|&e| ev_prim(e))
+}
+
+/// Index range of one axis's events.
+fn axis_run(events: &[u64], axis: usize) -> (usize, usize) {
+    let lo = events.partition_point(|&e| ev_axis(e) < axis);
+    let hi = events.partition_point(|&e| ev_axis(e) <= axis);
+    (lo, hi)
+}
+
+fn merge(a: Vec<u64>, b: &[u64]) -> Vec<u64> {
+    if b.is_empty() {
+        return a;
+    }
+    let mut out = Vec::with_capacity(a.len() + b.len());
+    let (mut i, mut j) = (0, 0);
+    while i < a.len() && j < b.len() {
+        if a[i] <= b[j] {
+            out.push(a[i]);
+            i += 1;
+        } else {
+            out.push(b[j]);
+            j += 1;
+        }
+    }
+    out.extend_from_slice(&a[i..]);
+    out.extend_from_slice(&b[j..]);
+    out
+}
+
+#[derive(Clone, Copy, Debug)]
+struct Split {
+    axis: usize,
+    pos: f32,
+    /// Which side primitives lying in the plane go to.
+    planar_left: bool,
+    cost: f32,
+}
+
+const BOTH: u8 = 0;
+const LEFT: u8 = 1;
+const RIGHT: u8 = 2;
+
+/// What `build` hands back to `KdTree`.
+pub(crate) struct Built {
+    pub nodes: Vec<KdNode>,
+    pub indices: Vec<u32>,
+    pub bounds: Aabb,
+    pub stats: KdStats,
+}
+
+struct Builder<'a, P: KdPrimitives + ?Sized> {
+    prims: &'a P,
+    traversal_cost: f32,
+    intersect_cost: f32,
+    empty_bonus: f32,
+    max_leaf_prims: u32,
+    max_depth: u32,
+    side: Vec<u8>,
+    nodes: Vec<KdNode>,
+    indices: Vec<u32>,
+    leaves: usize,
+    empty_leaves: usize,
+    depth_reached: u32,
+    prim_refs: usize,
+}
+
+pub(crate) fn build<P: KdPrimitives + ?Sized>(prims: &P, params: &KdParams) -> Built {
+    let n = prims.len();
+    assert!(
+        n <= MAX_PRIMS,
+        "kd-tree holds at most {MAX_PRIMS} primitives, got {n}"
+    );
+
+    // Boxes that are empty or not finite cannot take part in plane sweeps; they are left out.
+    let mut bounds = Aabb::EMPTY;
+    let mut events = Vec::with_capacity(6 * n);
+    let mut kept = 0usize;
+    for i in 0..n as u32 {
+        let b = prims.bounds(i);
+        if b.is_empty() || !b.min.is_finite() || !b.max.is_finite() {
+            continue;
+        }
+        kept += 1;
+        bounds = bounds.union(&b);
+        push_events(&mut events, i, &b);
+    }
+    events.sort_unstable();
+
+    let mut builder = Builder {
+        prims,
+        traversal_cost: params.traversal_cost,
+        intersect_cost: params.intersect_cost,
+        empty_bonus: params.empty_bonus,
+        max_leaf_prims: params.max_leaf_prims,
+        max_depth: params.depth_limit(kept),
+        side: vec![BOTH; n],
+        nodes: Vec::new(),
+        indices: Vec::new(),
+        leaves: 0,
+        empty_leaves: 0,
+        depth_reached: 0,
+        prim_refs: 0,
+    };
+    if kept > 0 {
+        builder.node(events, bounds, 0);
+    }
+
+    let non_empty = builder.leaves - builder.empty_leaves;
+    let stats = KdStats {
+        primitives: n,
+        skipped: n - kept,
+        nodes: builder.nodes.len(),
+        leaves: builder.leaves,
+        empty_leaves: builder.empty_leaves,
+        max_depth: builder.depth_reached,
+        mean_leaf_prims: if non_empty > 0 {
+            builder.prim_refs as f32 / non_empty as f32
+        } else {
+            0.0
+        },
+        prim_refs: builder.prim_refs,
+        build_seconds: 0.0,
+    };
+    Built {
+        nodes: builder.nodes,
+        indices: builder.indices,
+        bounds,
+        stats,
+    }
+}
+
+impl<P: KdPrimitives + ?Sized> Builder<'_, P> {
+    fn node(&mut self, events: Vec<u64>, cell: Aabb, depth: u32) {
+        let n = node_prims(&events).count() as u32;
+        let split = if n <= self.max_leaf_prims || depth >= self.max_depth {
+            None
+        } else {
+            self.find_split(&events, &cell, n)
+                .filter(|s| s.cost < self.intersect_cost * n as f32)
+        };
+        let Some(split) = split else {
+            self.leaf(&events, depth);
+            return;
+        };
+
+        let mut below = cell;
+        below.max[split.axis] = split.pos;
+        let mut above = cell;
+        above.min[split.axis] = split.pos;
+        let (left, right) = self.partition(&events, &split, &below, &above);
+        drop(events);
+
+        let me = self.nodes.len();
+        self.nodes.push(KdNode::leaf(0, 0)); // patched once the above child's index is known
+        self.node(left, below, depth + 1);
+        let above_index = u32::try_from(self.nodes.len()).expect("kd-tree node count");
+        self.nodes[me] = KdNode::interior(split.axis, split.pos, above_index);
+        self.node(right, above, depth + 1);
+    }
+
+    fn leaf(&mut self, events: &[u64], depth: u32) {
+        let mut prims: Vec<u32> = node_prims(events).collect();
+        prims.sort_unstable();
+        let count = prims.len() as u32;
+        let node = match prims.len() {
+            0 => KdNode::leaf(0, 0),
+            1 => KdNode::leaf(1, prims[0]),
+            _ => {
+                let offset = u32::try_from(self.indices.len()).expect("kd-tree index count");
+                self.indices.extend_from_slice(&prims);
+                KdNode::leaf(count, offset)
+            }
+        };
+        self.nodes.push(node);
+        self.leaves += 1;
+        self.empty_leaves += usize::from(count == 0);
+        self.prim_refs += prims.len();
+        self.depth_reached = self.depth_reached.max(depth);
+    }
+
+    /// SAH cost of a split; an empty side earns the bonus only if it has volume, since cutting
+    /// off a flat empty slab saves nothing.
+    #[inline]
+    fn cost(&self, pl: f32, pr: f32, nl: u32, nr: u32, wl: f32, wr: f32) -> f32 {
+        let empty = (nl == 0 && wl > 0.0) || (nr == 0 && wr > 0.0);
+        let scale = if empty { 1.0 - self.empty_bonus } else { 1.0 };
+        self.traversal_cost + self.intersect_cost * scale * (pl * nl as f32 + pr * nr as f32)
+    }
+
+    /// One sweep over the sorted events: at each candidate plane the counts of primitives
+    /// left of, in and right of it are known, and the plane's SAH cost follows.
+    fn find_split(&self, events: &[u64], cell: &Aabb, n: u32) -> Option<Split> {
+        let sa = cell.surface_area();
+        // A cell flat in two axes (a line or point of primitives) has no area to split.
+        if sa <= 0.0 {
+            return None;
+        }
+        let inv_sa = 1.0 / sa;
+        let d = cell.diagonal();
+        let mut best: Option<Split> = None;
+        let mut best_cost = f32::INFINITY;
+
+        let mut i = 0;
+        while i < events.len() {
+            let axis = ev_axis(events[i]);
+            let run = events[i..].partition_point(|&e| ev_axis(e) == axis);
+            let run = &events[i..i + run];
+            i += run.len();
+
+            let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+            // Side areas are 2 (cap + w * rim) for a side of width w along the axis.
+            let cap = d[u] * d[v];
+            let rim = d[u] + d[v];
+            let (lo, hi) = (cell.min[axis], cell.max[axis]);
+            let (mut nl, mut nr) = (0u32, n);
+            let mut j = 0;
+            while j < run.len() {
+                let plane = ev_plane(run[j]);
+                let pos = ev_pos(run[j]);
+                let (mut ends, mut planars, mut starts) = (0u32, 0u32, 0u32);
+                while j < run.len() && ev_plane(run[j]) == plane {
+                    let kind = ev_kind(run[j]);
+                    ends += u32::from(kind == END);
+                    planars += u32::from(kind == PLANAR);
+                    starts += u32::from(kind == START);
+                    j += 1;
+                }
+                nr -= ends + planars;
+
+                let (wl, wr) = (pos - lo, hi - pos);
+                let pl = 2.0 * (cap + wl * rim) * inv_sa;
+                let pr = 2.0 * (cap + wr * rim) * inv_sa;
+                let mut consider = |l: u32, r: u32, planar_left: bool| {
+                    // A flat side holding nothing leaves the other side the whole node.
+                    if (wl == 0.0 && l == 0) || (wr == 0.0 && r == 0) {
+                        return;
+                    }
+                    let c = self.cost(pl, pr, l, r, wl, wr);
+                    if c < best_cost {
+                        best_cost = c;
+                        best = Some(Split {
+                            axis,
+                            pos,
+                            planar_left,
+                            cost: c,
+                        });
+                    }
+                };
+                consider(nl + planars, nr, true);
+                if planars > 0 {
+                    consider(nl, nr + planars, false);
+                }
+                nl += starts + planars;
+            }
+        }
+        best
+    }
+
+    /// Splits the node's events into the children's, both still sorted: events of primitives
+    /// wholly on one side keep their order, straddling primitives get fresh clipped events
+    /// that are sorted and merged in.
+    fn partition(
+        &mut self,
+        events: &[u64],
+        split: &Split,
+        below: &Aabb,
+        above: &Aabb,
+    ) -> (Vec<u64>, Vec<u64>) {
+        // Every primitive has a planar event or a start before its end on the split axis, so
+        // one pass over that axis sets every side: a start left of the plane says both, until
+        // an end at or left of the plane says left only.
+        let (lo, hi) = axis_run(events, split.axis);
+        for &e in &events[lo..hi] {
+            let pos = ev_pos(e);
+            let side = &mut self.side[ev_prim(e) as usize];
+            match ev_kind(e) {
+                START => *side = if pos >= split.pos { RIGHT } else { BOTH },
+                END => {
+                    if pos <= split.pos {
+                        *side = LEFT;
+                    }
+                }
+                _ => {
+                    *side = if pos < split.pos || (pos == split.pos && split.planar_left) {
+                        LEFT
+                    } else {
+                        RIGHT
+                    }
+                }
+            }
+        }
+
+        // Sides are as good as random, so every event is written to both outputs and only the
+        // cursor of its own side advances: no branch to mispredict.
+        let mut left = vec![0u64; events.len()];
+        let mut right = vec![0u64; events.len()];
+        let (mut nl, mut nr) = (0, 0);
+        for &e in events {
+            let side = self.side[ev_prim(e) as usize];
+            left[nl] = e;
+            right[nr] = e;
+            nl += usize::from(side == LEFT);
+            nr += usize::from(side == RIGHT);
+        }
+        left.truncate(nl);
+        right.truncate(nr);
+
+        let mut new_left = Vec::new();
+        let mut new_right = Vec::new();
+        for p in node_prims(events) {
+            if self.side[p as usize] != BOTH {
+                continue;
+            }
+            let mut bl = self.prims.clipped_bounds(p, below).intersection(below);
+            let mut br = self.prims.clipped_bounds(p, above).intersection(above);
+            if bl.is_empty() && br.is_empty() {
+                // A clip that finds the primitive on neither side is numerical trouble: fall
+                // back to plain boxes rather than lose it.
+                let b = self.prims.bounds(p);
+                bl = b.intersection(below);
+                br = b.intersection(above);
+            }
+            if !bl.is_empty() {
+                push_events(&mut new_left, p, &bl);
+            }
+            if !br.is_empty() {
+                push_events(&mut new_right, p, &br);
+            }
+        }
+        new_left.sort_unstable();
+        new_right.sort_unstable();
+        (merge(left, &new_left), merge(right, &new_right))
+    }
+}
+
+/// Clamps a requested depth to what the traversal stack holds.
+pub(crate) fn clamp_depth(d: u32) -> u32 {
+    d.min(MAX_DEPTH)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::KdTree;
+    use super::*;
+    use glam::Vec3;
+
+    /// Deterministic xorshift so that the unit tests need no dev-dependency.
+    struct Rng(u64);
+    impl Rng {
+        fn f(&mut self) -> f32 {
+            self.0 ^= self.0 << 13;
+            self.0 ^= self.0 >> 7;
+            self.0 ^= self.0 << 17;
+            (self.0 >> 40) as f32 / (1u64 << 24) as f32
+        }
+        fn v(&mut self) -> Vec3 {
+            Vec3::new(self.f(), self.f(), self.f())
+        }
+    }
+
+    fn random_boxes(n: usize, size: f32, seed: u64) -> Vec<Aabb> {
+        let mut r = Rng(seed);
+        (0..n)
+            .map(|_| {
+                let c = r.v() * 10.0;
+                Aabb::new(c, c + r.v() * size)
+            })
+            .collect()
+    }
+
+    #[test]
+    fn event_keys_round_trip_and_order() {
+        for pos in [
+            0.0f32,
+            -0.0,
+            1.0,
+            -1.0,
+            3.5e-30,
+            -7.25e20,
+            f32::MAX,
+            -f32::MAX,
+        ] {
+            let e = event(2, pos, PLANAR, 12345);
+            assert_eq!(ev_axis(e), 2);
+            assert_eq!(ev_pos(e), pos);
+            assert_eq!(ev_kind(e), PLANAR);
+            assert_eq!(ev_prim(e), 12345);
+        }
+        assert_eq!(event(0, -0.0, END, 0), event(0, 0.0, END, 0));
+        let sorted = [
+            event(0, -2.0, START, 9),
+            event(0, -1.0, END, 9),
+            event(0, -1.0, PLANAR, 3),
+            event(0, -1.0, START, 1),
+            event(0, 0.0, END, 1),
+            event(0, 1e-30, END, 0),
+            event(1, -5.0, START, 0),
+        ];
+        assert!(sorted.windows(2).all(|w| w[0] < w[1]));
+    }
+
+    #[test]
+    fn merge_keeps_order() {
+        let a = vec![1, 4, 6, 9];
+        assert_eq!(merge(a, &[0, 5, 10]), vec![0, 1, 4, 5, 6, 9, 10]);
+        assert_eq!(merge(vec![], &[2, 3]), vec![2, 3]);
+    }
+
+    /// Points of a primitive that lie in a cell must find the primitive in some leaf reached
+    /// by descending to that point (either side when it is on a plane).
+    fn leaves_at(tree: &KdTree, p: Vec3, node: usize, out: &mut Vec<Vec<u32>>) {
+        let n = tree.nodes[node];
+        if n.is_leaf() {
+            out.push(tree.leaf_prims(&tree.nodes[node]).to_vec());
+            return;
+        }
+        let (a, s) = (n.axis(), n.split());
+        if p[a] <= s {
+            leaves_at(tree, p, node + 1, out);
+        }
+        if p[a] >= s {
+            leaves_at(tree, p, n.above() as usize, out);
+        }
+    }
+
+    fn check_covered(tree: &KdTree, prim: u32, p: Vec3) {
+        let mut found = Vec::new();
+        leaves_at(tree, p, 0, &mut found);
+        assert!(
+            found.iter().any(|l| l.contains(&prim)),
+            "primitive {prim} missing from the leaves at {p}"
+        );
+    }
+
+    fn check_structure(tree: &KdTree, boxes: &[Aabb]) {
+        let s = tree.stats();
+        assert_eq!(s.nodes, 2 * s.leaves - 1, "a full binary tree");
+        assert!(s.prim_refs >= boxes.len());
+        let mut r = Rng(99);
+        for (i, b) in boxes.iter().enumerate() {
+            for _ in 0..4 {
+                check_covered(tree, i as u32, b.min + r.v() * b.diagonal());
+            }
+            check_covered(tree, i as u32, b.min);
+            check_covered(tree, i as u32, b.max);
+        }
+    }
+
+    #[test]
+    fn random_boxes_are_covered() {
+        let boxes = random_boxes(2000, 0.6, 7);
+        let tree = KdTree::build(&boxes, &KdParams::default());
+        check_structure(&tree, &boxes);
+        let s = tree.stats();
+        assert_eq!(s.primitives, 2000);
+        assert!(s.leaves > 200, "{s:?}");
+        assert!(
+            s.mean_leaf_prims >= 1.0 && s.mean_leaf_prims < 10.0,
+            "{s:?}"
+        );
+        assert!(s.max_depth <= KdParams::default().depth_limit(2000));
+        assert!(s.build_seconds >= 0.0);
+    }
+
+    #[test]
+    fn depth_limit_is_honoured() {
+        let boxes = random_boxes(3000, 0.2, 3);
+        for limit in [0, 1, 3, 6] {
+            let params = KdParams {
+                max_depth: Some(limit),
+                ..KdParams::default()
+            };
+            let tree = KdTree::build(&boxes, &params);
+            assert!(tree.stats().max_depth <= limit);
+            check_structure(&tree, &boxes);
+        }
+        let tree = KdTree::build(
+            &boxes,
+            &KdParams {
+                max_depth: Some(0),
+                ..KdParams::default()
+            },
+        );
+        assert_eq!(tree.stats().nodes, 1);
+        assert_eq!(tree.stats().prim_refs, 3000);
+        let huge = KdParams {
+            max_depth: Some(1000),
+            ..KdParams::default()
+        };
+        assert_eq!(huge.depth_limit(10), MAX_DEPTH);
+    }
+
+    #[test]
+    fn default_depth_limit_follows_formula() {
+        let p = KdParams::default();
+        assert_eq!(p.depth_limit(0), 8);
+        assert_eq!(p.depth_limit(1), 8);
+        assert_eq!(p.depth_limit(1024), 21); // 8 + 13
+        assert_eq!(p.depth_limit(1 << 20), 34); // 8 + 26
+    }
+
+    #[test]
+    fn max_leaf_prims_stops_early() {
+        let boxes = random_boxes(500, 0.3, 11);
+        let params = KdParams {
+            max_leaf_prims: 600,
+            ..KdParams::default()
+        };
+        assert_eq!(KdTree::build(&boxes, &params).stats().nodes, 1);
+    }
+
+    #[test]
+    fn identical_boxes_make_one_leaf() {
+        let boxes = vec![Aabb::new(Vec3::ZERO, Vec3::ONE); 50];
+        let tree = KdTree::build(&boxes, &KdParams::default());
+        assert_eq!(tree.stats().nodes, 1);
+        assert_eq!(tree.stats().prim_refs, 50);
+    }
+
+    #[test]
+    fn empty_space_is_cut_off() {
+        // A tight cluster in one corner of a large box: the bonus should carve empty leaves.
+        let mut boxes = random_boxes(200, 0.05, 5)
+            .into_iter()
+            .map(|b| Aabb::new(b.min * 0.1, b.max * 0.1))
+            .collect::<Vec<_>>();
+        boxes.push(Aabb::new(Vec3::splat(9.0), Vec3::splat(10.0)));
+        let tree = KdTree::build(&boxes, &KdParams::default());
+        assert!(tree.stats().empty_leaves > 0);
+        check_structure(&tree, &boxes);
+    }
+
+    #[test]
+    fn planar_boxes_split_and_stay_covered() {
+        // Rectangles in a few shared planes of every orientation, plus flat cells.
+        let mut r = Rng(21);
+        let mut boxes = Vec::new();
+        for i in 0..600 {
+            let axis = i % 3;
+            let mut lo = r.v() * 10.0;
+            let mut hi = lo + r.v() * 2.0;
+            let plane = (r.f() * 5.0).floor() * 2.0;
+            lo[axis] = plane;
+            hi[axis] = plane;
+            boxes.push(Aabb::new(lo, hi));
+        }
+        let tree = KdTree::build(&boxes, &KdParams::default());
+        check_structure(&tree, &boxes);
+        assert!(tree.stats().leaves > 50);
+
+        // All primitives in one plane: the root cell itself is flat.
+        let flat: Vec<Aabb> = (0..300)
+            .map(|i| {
+                let x = (i % 20) as f32;
+                let y = (i / 20) as f32;
+                Aabb::new(Vec3::new(x, y, 1.0), Vec3::new(x + 0.5, y + 0.5, 1.0))
+            })
+            .collect();
+        let tree = KdTree::build(&flat, &KdParams::default());
+        check_structure(&tree, &flat);
+        assert!(tree.stats().leaves > 100);
+        assert!(tree.bounds().min.z == 1.0 && tree.bounds().max.z == 1.0);
+    }
+
+    #[test]
+    fn unusable_boxes_are_skipped() {
+        let mut boxes = random_boxes(10, 1.0, 1);
+        boxes.push(Aabb::EMPTY);
+        boxes.push(Aabb::new(Vec3::ZERO, Vec3::new(f32::INFINITY, 1.0, 1.0)));
+        boxes.push(Aabb {
+            min: Vec3::splat(f32::NAN),
+            max: Vec3::ONE,
+        });
+        let tree = KdTree::build(&boxes, &KdParams::default());
+        assert_eq!(tree.stats().primitives, 13);
+        assert_eq!(tree.stats().skipped, 3);
+        assert!(tree.bounds().max.is_finite());
+        check_structure(&tree, &boxes[..10]);
+    }
+
+    /// Thin diagonal segments whose clipped bounds are far tighter than box ∩ cell, and can be
+    /// empty on one side of a straddled plane.
+    struct Segments(Vec<(Vec3, Vec3)>);
+
+    impl KdPrimitives for Segments {
+        fn len(&self) -> usize {
+            self.0.len()
+        }
+        fn bounds(&self, i: u32) -> Aabb {
+            let (a, b) = self.0[i as usize];
+            Aabb::new(a, b)
+        }
+        fn clipped_bounds(&self, i: u32, node: &Aabb) -> Aabb {
+            // Liang–Barsky: the parameter range of the segment inside the cell.
+            let (a, b) = self.0[i as usize];
+            let d = b - a;
+            let (mut t0, mut t1) = (0.0f32, 1.0f32);
+            for k in 0..3 {
+                if d[k] == 0.0 {
+                    if a[k] < node.min[k] || a[k] > node.max[k] {
+                        return Aabb::EMPTY;
+                    }
+                    continue;
+                }
+                let (mut n, mut f) = ((node.min[k] - a[k]) / d[k], (node.max[k] - a[k]) / d[k]);
+                if n > f {
+                    std::mem::swap(&mut n, &mut f);
+                }
+                t0 = t0.max(n);
+                t1 = t1.min(f);
+            }
+            if t0 > t1 {
+                return Aabb::EMPTY;
+            }
+            // Round outwards by the cell-independent box so the clip never loses a sliver.
+            Aabb::new(a + d * t0, a + d * t1)
+                .padded(1e-6, 1e-6)
+                .intersection(&self.bounds(i))
+        }
+    }
+
+    #[test]
+    fn custom_clipping_is_used_and_covers() {
+        let mut r = Rng(77);
+        let segs = Segments(
+            (0..1500)
+                .map(|_| {
+                    let a = r.v() * 10.0;
+                    (a, a + (r.v() - 0.5) * 3.0)
+                })
+                .collect(),
+        );
+        let clipped = KdTree::build(&segs, &KdParams::default());
+        let boxes: Vec<Aabb> = (0..segs.len() as u32).map(|i| segs.bounds(i)).collect();
+        let plain = KdTree::build(&boxes, &KdParams::default());
+        // Tighter clipped events mean fewer duplicated references.
+        assert!(
+            clipped.stats().prim_refs < plain.stats().prim_refs,
+            "{:?} vs {:?}",
+            clipped.stats(),
+            plain.stats()
+        );
+        for (i, &(a, b)) in segs.0.iter().enumerate() {
+            for k in 0..=8 {
+                check_covered(&clipped, i as u32, a.lerp(b, k as f32 / 8.0));
+            }
+        }
+    }
+}

@@ -1,0 +1,198 @@
+//! SAH kd-tree over primitive bounding boxes.
+//!
+//! **Build** (Wald & Havran 2006, "On building fast kd-trees for ray tracing, and on doing that
+//! in O(N log N)"). Each primitive gives, per axis, a start and an end event at its box faces,
+//! or one planar event where the box is flat. All events are sorted once. In each node one
+//! sweep over its sorted events counts the primitives left of, in and right of every candidate
+//! plane and prices the plane with the surface area heuristic (planar primitives go to the
+//! cheaper side; a side with volume but no primitives earns pbrt's empty-space bonus). The
+//! node becomes a leaf when no plane beats intersecting everything, at the depth limit, or at
+//! `max_leaf_prims`. Otherwise the primitives are classified left, right or both; events of
+//! one-sided primitives keep their order, straddlers get fresh events from
+//! [`KdPrimitives::clipped_bounds`] that are sorted and merged in, so no child is re-sorted
+//! and the whole build stays O(N log N).
+//!
+//! **Layout** (as in pbrt). Nodes are 8 bytes in one depth-first array: an interior node holds
+//! the split position and, beside the axis in two low bits, the index of its above child; its
+//! below child is the next node. A leaf holds its primitive count and either its only primitive
+//! or an offset into the primitive index array.
+//!
+//! **Traversal** clips the ray to the tree bounds, then walks front to back with a fixed stack
+//! of far children; a closest-hit query stops once its best hit lies before the current leaf's
+//! far end. A ray lying in a split plane visits both children, so boxes touching the plane
+//! from either side are seen.
+
+mod build;
+mod node;
+mod traverse;
+
+use crate::geometry::Aabb;
+use node::KdNode;
+use std::time::Instant;
+
+pub use build::MAX_PRIMS;
+
+/// Deepest tree the traversal stack can walk; deeper requested limits are clamped to this.
+pub const MAX_DEPTH: u32 = 64;
+
+/// Cost model and limits of the build.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct KdParams {
+    /// Cost of one traversal step.
+    pub traversal_cost: f32,
+    /// Cost of one ray–primitive test, in the same unit.
+    pub intersect_cost: f32,
+    /// Fraction of a split's cost forgiven when one side is empty space.
+    pub empty_bonus: f32,
+    /// Nodes with at most this many primitives become leaves.
+    pub max_leaf_prims: u32,
+    /// Depth limit; `None` picks 8 + 1.3 log2(N). Clamped to [`MAX_DEPTH`].
+    pub max_depth: Option<u32>,
+}
+
+impl Default for KdParams {
+    fn default() -> Self {
+        Self {
+            traversal_cost: 1.0,
+            // A ray–primitive test costs about 1.5 node steps.
+            intersect_cost: 1.5,
+            empty_bonus: 0.5,
+            max_leaf_prims: 1,
+            max_depth: None,
+        }
+    }
+}
+
+impl KdParams {
+    /// The depth limit a build over `n` primitives uses.
+    pub fn depth_limit(&self, n: usize) -> u32 {
+        let d = self
+            .max_depth
+            .unwrap_or_else(|| (8.0 + 1.3 * (n.max(1) as f64).log2()).round() as u32);
+        build::clamp_depth(d)
+    }
+}
+
+/// What the builder needs to know of the primitives: it knows boxes, never shapes.
+pub trait KdPrimitives {
+    fn len(&self) -> usize;
+
+    fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// Must hold every point the primitive's intersection can report, rounding included
+    /// (see [`Aabb::padded`]): rays only reach the cells they pass through. Empty or non-finite
+    /// bounds leave the primitive out of the tree.
+    fn bounds(&self, i: u32) -> Aabb;
+
+    /// Bounds of the part of primitive i inside `node` (perfect splits clip triangles here
+    /// later); default: bounds ∩ node. An empty box says the primitive misses the node.
+    fn clipped_bounds(&self, i: u32, node: &Aabb) -> Aabb {
+        self.bounds(i).intersection(node)
+    }
+}
+
+impl KdPrimitives for [Aabb] {
+    fn len(&self) -> usize {
+        <[Aabb]>::len(self)
+    }
+
+    fn bounds(&self, i: u32) -> Aabb {
+        self[i as usize]
+    }
+}
+
+impl KdPrimitives for Vec<Aabb> {
+    fn len(&self) -> usize {
+        self.as_slice().len()
+    }
+
+    fn bounds(&self, i: u32) -> Aabb {
+        self[i as usize]
+    }
+}
+
+/// Figures of a finished build.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct KdStats {
+    /// Primitives handed to the build.
+    pub primitives: usize,
+    /// Of those, left out because their bounds were empty or not finite.
+    pub skipped: usize,
+    pub nodes: usize,
+    pub leaves: usize,
+    pub empty_leaves: usize,
+    /// Depth of the deepest leaf (the root is at depth 0).
+    pub max_depth: u32,
+    /// Mean primitive count of the non-empty leaves.
+    pub mean_leaf_prims: f32,
+    /// Primitive references over all leaves (a straddling primitive counts once per leaf).
+    pub prim_refs: usize,
+    pub build_seconds: f64,
+}
+
+impl std::fmt::Display for KdStats {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(
+            f,
+            "{} prims ({} skipped), {} nodes, {} leaves ({} empty), depth {}, {:.2} prims/leaf, \
+             {} refs, {:.3} s",
+            self.primitives,
+            self.skipped,
+            self.nodes,
+            self.leaves,
+            self.empty_leaves,
+            self.max_depth,
+            self.mean_leaf_prims,
+            self.prim_refs,
+            self.build_seconds
+        )
+    }
+}
+
+/// A kd-tree over primitive indices; intersection is left to the caller's callbacks.
+#[derive(Clone, Debug)]
+pub struct KdTree {
+    nodes: Vec<KdNode>,
+    indices: Vec<u32>,
+    bounds: Aabb,
+    stats: KdStats,
+}
+
+impl KdTree {
+    pub fn build<P: KdPrimitives + ?Sized>(prims: &P, params: &KdParams) -> KdTree {
+        let start = Instant::now();
+        let built = build::build(prims, params);
+        let mut stats = built.stats;
+        stats.build_seconds = start.elapsed().as_secs_f64();
+        KdTree {
+            nodes: built.nodes,
+            indices: built.indices,
+            bounds: built.bounds,
+            stats,
+        }
+    }
+
+    /// Union of the bounds of the primitives in the tree (`Aabb::EMPTY` when there are none).
+    pub fn bounds(&self) -> Aabb {
+        self.bounds
+    }
+
+    pub fn stats(&self) -> &KdStats {
+        &self.stats
+    }
+
+    /// The primitives of a leaf node, which must be one of `self.nodes`.
+    #[inline]
+    fn leaf_prims<'a>(&'a self, leaf: &'a KdNode) -> &'a [u32] {
+        match leaf.prim_count() {
+            0 => &[],
+            1 => std::slice::from_ref(leaf.payload()),
+            n => {
+                let at = *leaf.payload() as usize;
+                &self.indices[at..at + n as usize]
+            }
+        }
+    }
+}

@@ -1,0 +1,273 @@
+//! Front-to-back traversal.
+
+use super::{KdTree, MAX_DEPTH};
+use crate::geometry::Ray;
+use glam::Vec3;
+
+/// A far child still to visit, with the ray's parametric range inside it.
+#[derive(Clone, Copy)]
+struct Todo {
+    node: u32,
+    t0: f32,
+    t1: f32,
+}
+
+// Each interior node on the current path pushes at most one entry, so the depth bounds the stack.
+const STACK: usize = MAX_DEPTH as usize;
+
+impl KdTree {
+    /// Closest hit. Calls `isect(prim, t_max_now)` for candidate primitives in front-to-back
+    /// order; the callback returns `Some(t)` only for a hit with `0 < t < t_max_now` (the caller
+    /// records u, v, etc.). Returns the closest `t` found, or `None`. Stops as soon as the best
+    /// hit lies before the current leaf's far distance.
+    ///
+    /// A primitive that spans several leaves may be offered more than once.
+    pub fn closest_hit(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        mut isect: impl FnMut(u32, f32) -> Option<f32>,
+    ) -> Option<f32> {
+        let mut best = None;
+        self.walk(ray, t_max, |prims, t_far, mut limit| {
+            for &p in prims {
+                // Re-check the contract so a careless callback cannot move the hit backwards.
+                if let Some(t) = isect(p, limit).filter(|&t| t < limit) {
+                    limit = t;
+                    best = Some(t);
+                }
+            }
+            // Hits are sorted by leaf, so one before this leaf's end beats all later leaves.
+            if best.is_some() && limit < t_far {
+                None
+            } else {
+                Some(limit)
+            }
+        });
+        best
+    }
+
+    /// Any hit before `t_max` (shadow rays): stops at the first `occluded(prim, t_max)` that
+    /// returns true.
+    pub fn any_hit(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        mut occluded: impl FnMut(u32, f32) -> bool,
+    ) -> bool {
+        let mut hit = false;
+        self.walk(ray, t_max, |prims, _, limit| {
+            if prims.iter().any(|&p| occluded(p, t_max)) {
+                hit = true;
+                None
+            } else {
+                Some(limit)
+            }
+        });
+        hit
+    }
+
+    /// Visits the leaves the ray passes through, front to back. `leaf(prims, t_far, limit)`
+    /// returns the new limit (pending subtrees starting beyond it are skipped), or `None` to stop.
+    #[inline]
+    fn walk(&self, ray: &Ray, t_max: f32, mut leaf: impl FnMut(&[u32], f32, f32) -> Option<f32>) {
+        if self.nodes.is_empty() {
+            return;
+        }
+        // 1/±0 = ±inf: axis-parallel rays get infinite plane distances, handled below.
+        let inv_d = Vec3::ONE / ray.d;
+        let Some((mut t0, mut t1)) = self.bounds.intersect_p(ray, inv_d, t_max) else {
+            return;
+        };
+        let mut limit = t_max;
+        let mut stack = [Todo {
+            node: 0,
+            t0: 0.0,
+            t1: 0.0,
+        }; STACK];
+        let mut sp = 0;
+        let mut index = 0usize;
+        loop {
+            let node = &self.nodes[index];
+            if !node.is_leaf() {
+                let axis = node.axis();
+                let split = node.split();
+                let o = ray.o[axis];
+                let t_plane = (split - o) * inv_d[axis];
+                // From on the plane, the side the ray heads into comes first.
+                let below_first = o < split || (o == split && ray.d[axis] <= 0.0);
+                let (first, second) = if below_first {
+                    (index + 1, node.above() as usize)
+                } else {
+                    (node.above() as usize, index + 1)
+                };
+                if t_plane.is_nan() {
+                    // 0 · inf: the ray lies in the plane, touching both children all along.
+                    stack[sp] = Todo {
+                        node: second as u32,
+                        t0,
+                        t1,
+                    };
+                    sp += 1;
+                    index = first;
+                } else if t_plane > t1 || t_plane <= 0.0 || t_plane == f32::INFINITY {
+                    index = first;
+                } else if t_plane < t0 {
+                    index = second;
+                } else {
+                    stack[sp] = Todo {
+                        node: second as u32,
+                        t0: t_plane,
+                        t1,
+                    };
+                    sp += 1;
+                    index = first;
+                    t1 = t_plane;
+                }
+                continue;
+            }
+
+            match leaf(self.leaf_prims(node), t1, limit) {
+                Some(l) => limit = l,
+                None => return,
+            }
+            // Pending entries start no earlier than the top one, so one past the limit ends it.
+            if sp == 0 {
+                return;
+            }
+            sp -= 1;
+            let todo = stack[sp];
+            if todo.t0 > limit {
+                return;
+            }
+            index = todo.node as usize;
+            t0 = todo.t0;
+            t1 = todo.t1;
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::super::{KdParams, KdTree};
+    use crate::geometry::{Aabb, Ray};
+    use glam::Vec3;
+
+    /// Slab test that reports the entry distance, or the exit one from inside.
+    fn hit_box(b: &Aabb, ray: &Ray, t_max: f32) -> Option<f32> {
+        let inv = Vec3::ONE / ray.d;
+        let (mut t0, mut t1) = (f32::NEG_INFINITY, f32::INFINITY);
+        for a in 0..3 {
+            let mut n = (b.min[a] - ray.o[a]) * inv[a];
+            let mut f = (b.max[a] - ray.o[a]) * inv[a];
+            if n.is_nan() || f.is_nan() {
+                return None;
+            }
+            if n > f {
+                std::mem::swap(&mut n, &mut f);
+            }
+            t0 = t0.max(n);
+            t1 = t1.min(f);
+        }
+        if t0 > t1 {
+            return None;
+        }
+        [t0, t1].into_iter().find(|&t| t > 0.0 && t < t_max)
+    }
+
+    fn grid_boxes() -> Vec<Aabb> {
+        let mut v = Vec::new();
+        for x in 0..8 {
+            for y in 0..8 {
+                for z in 0..8 {
+                    let p = Vec3::new(x as f32, y as f32, z as f32) * 2.0;
+                    v.push(Aabb::new(p, p + Vec3::splat(1.0)));
+                }
+            }
+        }
+        v
+    }
+
+    fn brute(boxes: &[Aabb], ray: &Ray, t_max: f32) -> Option<(u32, f32)> {
+        let mut best: Option<(u32, f32)> = None;
+        for (i, b) in boxes.iter().enumerate() {
+            let lim = best.map_or(t_max, |h| h.1);
+            if let Some(t) = hit_box(b, ray, lim) {
+                best = Some((i as u32, t));
+            }
+        }
+        best
+    }
+
+    fn kd(tree: &KdTree, boxes: &[Aabb], ray: &Ray, t_max: f32) -> Option<(u32, f32)> {
+        let mut prim = None;
+        let t = tree.closest_hit(ray, t_max, |p, lim| {
+            let t = hit_box(&boxes[p as usize], ray, lim);
+            if t.is_some() {
+                prim = Some(p);
+            }
+            t
+        })?;
+        Some((prim.unwrap(), t))
+    }
+
+    #[test]
+    fn empty_tree_misses() {
+        let tree = KdTree::build(&Vec::<Aabb>::new(), &KdParams::default());
+        assert_eq!(tree.stats().nodes, 0);
+        let ray = Ray::new(Vec3::ZERO, Vec3::X);
+        assert_eq!(
+            tree.closest_hit(&ray, f32::INFINITY, |_, _| Some(1.0)),
+            None
+        );
+        assert!(!tree.any_hit(&ray, f32::INFINITY, |_, _| true));
+    }
+
+    #[test]
+    fn axis_rays_through_grid_match_brute_force() {
+        let boxes = grid_boxes();
+        let tree = KdTree::build(&boxes, &KdParams::default());
+        let mut checked = 0;
+        // Origins on box faces (the candidate planes), between boxes and outside, along
+        // every signed axis with ±0 in the other components.
+        let coords = [-1.0f32, 0.0, 0.5, 1.0, 1.5, 2.0, 3.0, 7.0, 15.0, 16.0];
+        for &x in &coords {
+            for &y in &coords {
+                for &z in &coords {
+                    let o = Vec3::new(x, y, z);
+                    for a in 0..3 {
+                        for s in [1.0f32, -1.0] {
+                            for zero in [0.0f32, -0.0] {
+                                let mut d = Vec3::splat(zero);
+                                d[a] = s;
+                                let ray = Ray::new(o, d);
+                                for t_max in [f32::INFINITY, 3.0] {
+                                    let want = brute(&boxes, &ray, t_max);
+                                    assert_eq!(kd(&tree, &boxes, &ray, t_max), want, "{ray:?}");
+                                    let any = tree.any_hit(&ray, t_max, |p, tm| {
+                                        hit_box(&boxes[p as usize], &ray, tm).is_some()
+                                    });
+                                    assert_eq!(any, want.is_some());
+                                    checked += 1;
+                                }
+                            }
+                        }
+                    }
+                }
+            }
+        }
+        assert_eq!(checked, 1000 * 24);
+    }
+
+    #[test]
+    fn callback_results_past_the_limit_are_ignored() {
+        let boxes = grid_boxes();
+        let tree = KdTree::build(&boxes, &KdParams::default());
+        let ray = Ray::new(Vec3::new(-1.0, 0.5, 0.5), Vec3::X);
+        // A callback that ignores t_max_now must not make the answer worse than the truth.
+        let t = tree.closest_hit(&ray, f32::INFINITY, |p, _| {
+            hit_box(&boxes[p as usize], &ray, f32::INFINITY)
+        });
+        assert_eq!(t, Some(1.0));
+    }
+}

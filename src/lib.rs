@@ -1,0 +1,17 @@
+//! prism: a physically based spectral path tracer.
+//!
+//! A RON scene becomes a `hecs` world (`scene_file`); systems flatten it into arrays, a
+//! kd-tree and a light list (`systems`, `kdtree`); a wavefront integrator pushes batches of
+//! rays through them (`integrator`); the film writes PNG or EXR (`film`).
+
+#![forbid(unsafe_code)]
+
+pub mod cli;
+pub mod components;
+pub mod film;
+pub mod geometry;
+pub mod integrator;
+pub mod kdtree;
+pub mod sampling;
+pub mod scene_file;
+pub mod systems;

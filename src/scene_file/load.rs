@@ -1,0 +1,309 @@
+//! Scene file → ECS world: parse, apply `--set` overrides, spawn one entity per object.
+
+use super::error::{SceneError, context_at, offset_of};
+use super::schema;
+use crate::components::{Camera, Material, Name, Shape, Transform};
+use glam::{Affine3A, Quat, Vec3};
+use std::path::{Path, PathBuf};
+
+/// Integrator and image settings, after overrides.
+#[derive(Clone, Debug)]
+pub struct RenderSettings {
+    pub width: u32,
+    pub height: u32,
+    pub spp: u32,
+    pub max_depth: u32,
+    pub seed: u64,
+    pub light_sampling: schema::LightSampling,
+    pub rr_depth: u32,
+    pub fresnel: schema::Fresnel,
+    pub wavelengths: u32,
+    pub sampler: schema::SamplerChoice,
+}
+
+/// A loaded scene: the world of entities and the resources beside it.
+pub struct LoadedScene {
+    pub path: PathBuf,
+    pub world: hecs::World,
+    pub camera: Camera,
+    pub render: RenderSettings,
+    /// Radiance of the constant environment (zero when absent).
+    pub environment: Vec3,
+    /// Hash of the scene text and every override except the sample count, so renders of the
+    /// same scene with different sample ranges can be matched.
+    pub hash: u64,
+}
+
+/// Reads and parses a scene file, with `--set` overrides applied.
+pub fn load(path: &Path, overrides: &[(String, String)]) -> Result<LoadedScene, SceneError> {
+    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
+        path: path.to_path_buf(),
+        source,
+    })?;
+    load_str(&text, path, overrides)
+}
+
+/// Parses scene text; `path` is used in messages and to resolve relative asset paths.
+pub fn load_str(
+    text: &str,
+    path: &Path,
+    overrides: &[(String, String)],
+) -> Result<LoadedScene, SceneError> {
+    let mut scene = parse(text, path)?;
+    let mut hash = fnv1a(text.as_bytes(), FNV_OFFSET);
+    for (k, v) in overrides {
+        apply_override(&mut scene, k, v)?;
+        if k != "render.spp" {
+            hash = fnv1a(k.as_bytes(), hash);
+            hash = fnv1a(v.as_bytes(), hash);
+        }
+    }
+    build_world(scene, path, hash)
+}
+
+/// Deserialises the schema, turning RON's error position into file:line:col with the entity
+/// and field it falls in.
+pub fn parse(text: &str, path: &Path) -> Result<schema::Scene, SceneError> {
+    ron::Options::default()
+        .from_str::<schema::Scene>(text)
+        .map_err(|e| {
+            let pos = e.span.start;
+            let at = offset_of(text, pos.line, pos.col);
+            let (entity, field) = context_at(text, at);
+            SceneError::Parse {
+                path: path.to_path_buf(),
+                line: pos.line,
+                col: pos.col,
+                entity,
+                field,
+                message: e.code.to_string(),
+            }
+        })
+}
+
+const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
+
+fn fnv1a(bytes: &[u8], mut h: u64) -> u64 {
+    for &b in bytes {
+        h ^= b as u64;
+        h = h.wrapping_mul(0x0100_0000_01b3);
+    }
+    h
+}
+
+/// The keys `--set` understands, with the type their value is parsed as.
+pub const OVERRIDE_KEYS: &[&str] = &[
+    "render.width",
+    "render.height",
+    "render.spp",
+    "render.max_depth",
+    "render.seed",
+    "render.integrator.light_sampling",
+    "render.integrator.rr_depth",
+    "render.integrator.fresnel",
+    "render.integrator.wavelengths",
+    "render.integrator.sampler",
+    "camera.position",
+    "camera.look_at",
+    "camera.up",
+    "camera.fov_y",
+    "camera.lens.aperture_radius",
+    "camera.lens.focus_distance",
+    "camera.lens.blades",
+    "environment",
+];
+
+/// Applies one `--set KEY=VALUE`; VALUE is RON for the field's type (`Schlick`, `64`,
+/// `(0.0, 1.0, 5.0)`), checked like the field in the file.
+pub fn apply_override(
+    scene: &mut schema::Scene,
+    key: &str,
+    value: &str,
+) -> Result<(), SceneError> {
+    fn val<T: serde::de::DeserializeOwned>(key: &str, value: &str) -> Result<T, SceneError> {
+        ron::from_str(value).map_err(|e| SceneError::Override {
+            key: key.to_string(),
+            message: format!("cannot use '{value}': {}", e.code),
+        })
+    }
+    let r = &mut scene.render;
+    let c = &mut scene.camera;
+    let lens = || schema::Lens {
+        aperture_radius: schema::NonNegative(0.0),
+        focus_distance: schema::Positive(1.0),
+        blades: schema::Blades(0),
+    };
+    match key {
+        "render.width" => r.width = val(key, value)?,
+        "render.height" => r.height = val(key, value)?,
+        "render.spp" => r.spp = val(key, value)?,
+        "render.max_depth" => r.max_depth = val(key, value)?,
+        "render.seed" => r.seed = val(key, value)?,
+        "render.integrator.light_sampling" => r.integrator.light_sampling = val(key, value)?,
+        "render.integrator.rr_depth" => r.integrator.rr_depth = val(key, value)?,
+        "render.integrator.fresnel" => r.integrator.fresnel = val(key, value)?,
+        "render.integrator.wavelengths" => r.integrator.wavelengths = val(key, value)?,
+        "render.integrator.sampler" => r.integrator.sampler = val(key, value)?,
+        "camera.position" => c.position = val(key, value)?,
+        "camera.look_at" => c.look_at = val(key, value)?,
+        "camera.up" => c.up = val(key, value)?,
+        "camera.fov_y" => c.fov_y = val(key, value)?,
+        "camera.lens.aperture_radius" => {
+            c.lens.get_or_insert_with(lens).aperture_radius = val(key, value)?
+        }
+        "camera.lens.focus_distance" => {
+            c.lens.get_or_insert_with(lens).focus_distance = val(key, value)?
+        }
+        "camera.lens.blades" => c.lens.get_or_insert_with(lens).blades = val(key, value)?,
+        "environment" => scene.environment = Some(val(key, value)?),
+        _ => {
+            return Err(SceneError::Override {
+                key: key.to_string(),
+                message: format!("unknown key; valid keys: {}", OVERRIDE_KEYS.join(", ")),
+            });
+        }
+    }
+    Ok(())
+}
+
+fn transform_of(t: &Option<schema::Transform>) -> Transform {
+    let Some(t) = t else {
+        return Transform::default();
+    };
+    let s = t.scale.map_or(Vec3::ONE, |s| Vec3::from_array(s.0));
+    let r = t.rotate.map_or(Vec3::ZERO, |r| r.vec());
+    let rot = Quat::from_rotation_z(r.z.to_radians())
+        * Quat::from_rotation_y(r.y.to_radians())
+        * Quat::from_rotation_x(r.x.to_radians());
+    let tr = t.translate.map_or(Vec3::ZERO, |t| t.vec());
+    let uniform = (s.x.abs() == s.y.abs() && s.y.abs() == s.z.abs()).then_some(s.x.abs());
+    Transform {
+        to_world: Affine3A::from_scale_rotation_translation(s, rot, tr),
+        uniform_scale: uniform,
+    }
+}
+
+fn build_world(scene: schema::Scene, path: &Path, hash: u64) -> Result<LoadedScene, SceneError> {
+    let cam = &scene.camera;
+    let (pos, at, up) = (cam.position.vec(), cam.look_at.vec(), cam.up.vec());
+    let fwd = at - pos;
+    if fwd.length_squared() == 0.0 || fwd.cross(up).length_squared() <= 1e-12 * fwd.length_squared() * up.length_squared() {
+        return Err(SceneError::Entity {
+            path: path.to_path_buf(),
+            entity: "camera".into(),
+            field: "look_at",
+            message: "look_at must differ from position, and up must not be parallel to the view direction".into(),
+        });
+    }
+    let camera = Camera {
+        position: pos,
+        look_at: at,
+        up,
+        fov_y: cam.fov_y.0,
+        aperture_radius: cam.lens.as_ref().map_or(0.0, |l| l.aperture_radius.0),
+        focus_distance: cam.lens.as_ref().map_or(1.0, |l| l.focus_distance.0),
+        blades: cam.lens.as_ref().map_or(0, |l| l.blades.0),
+        shutter: cam.shutter.as_ref().map_or((0.0, 1.0), |s| (s.open, s.close)),
+    };
+    let r = &scene.render;
+    let render = RenderSettings {
+        width: r.width.0,
+        height: r.height.0,
+        spp: r.spp.0,
+        max_depth: r.max_depth,
+        seed: r.seed,
+        light_sampling: r.integrator.light_sampling,
+        rr_depth: r.integrator.rr_depth,
+        fresnel: r.integrator.fresnel,
+        wavelengths: r.integrator.wavelengths.0,
+        sampler: r.integrator.sampler,
+    };
+    let environment = match &scene.environment {
+        Some(schema::Environment::Constant(e)) => e.0.vec(),
+        None => Vec3::ZERO,
+    };
+
+    let mut world = hecs::World::new();
+    for (i, e) in scene.entities.iter().enumerate() {
+        let name = e.name.clone().unwrap_or_else(|| format!("#{i}"));
+        let err = |field: &'static str, message: String| SceneError::Entity {
+            path: path.to_path_buf(),
+            entity: name.clone(),
+            field,
+            message,
+        };
+        let transform = transform_of(&e.transform);
+        let Some(shape) = &e.shape else {
+            return Err(err("shape", "every entity needs a shape".into()));
+        };
+        let shape = match *shape {
+            schema::Shape::Sphere { center, radius } => {
+                if transform.uniform_scale.is_none() {
+                    return Err(err(
+                        "transform",
+                        "a Sphere takes a uniform scale only (a non-uniform one would make an ellipsoid)".into(),
+                    ));
+                }
+                Shape::Sphere {
+                    center: center.vec(),
+                    radius: radius.0,
+                }
+            }
+            schema::Shape::Rect { center, u, v } => Shape::Rect {
+                center: center.vec(),
+                u: u.vec(),
+                v: v.vec(),
+            },
+            schema::Shape::Disk {
+                center,
+                normal,
+                radius,
+            } => Shape::Disk {
+                center: center.vec(),
+                normal: normal.vec().normalize(),
+                radius: radius.0,
+            },
+            schema::Shape::Box { min, max } => Shape::Box {
+                min: min.vec(),
+                max: max.vec(),
+            },
+        };
+        let material = match &e.material {
+            None => {
+                return Err(err(
+                    "material",
+                    "a shape needs a material (Diffuse, Mirror, Dielectric or Light)".into(),
+                ));
+            }
+            Some(schema::Material::Diffuse { albedo }) => Material::Diffuse {
+                albedo: albedo.0.vec(),
+            },
+            Some(schema::Material::Mirror { tint }) => Material::Mirror { tint: tint.0.vec() },
+            Some(schema::Material::Dielectric { ior }) => Material::Dielectric { ior: ior.0 },
+            Some(schema::Material::Light {
+                emission,
+                two_sided,
+            }) => {
+                if matches!(shape, Shape::Box { .. }) {
+                    return Err(err(
+                        "material",
+                        "a Light needs a Sphere, Rect or Disk (area lights are sampled on those); use Rect faces for a box-shaped lamp".into(),
+                    ));
+                }
+                Material::Light {
+                    emission: emission.0.vec(),
+                    two_sided: *two_sided,
+                }
+            }
+        };
+        world.spawn((Name(name), shape, transform, material));
+    }
+    Ok(LoadedScene {
+        path: path.to_path_buf(),
+        world,
+        camera,
+        render,
+        environment,
+        hash,
+    })
+}

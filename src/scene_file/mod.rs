@@ -1,0 +1,8 @@
+//! The RON scene file: schema (the public contract), loading into an ECS world, errors.
+
+pub mod error;
+pub mod load;
+pub mod schema;
+
+pub use error::SceneError;
+pub use load::{LoadedScene, RenderSettings, apply_override, load, load_str};

@@ -1,0 +1,591 @@
+//! serde types of the RON scene file: the public contract of DESIGN.md.
+//!
+//! Value ranges are checked here, during deserialisation (`#[serde(try_from)]` newtypes), so
+//! that a bad value is reported with the line and column where it stands. Parts of the schema
+//! that this build does not simulate yet are parsed and then refused with a message that says
+//! so, never ignored.
+
+use serde::de::{self, Deserializer, IgnoredAny, SeqAccess, Visitor};
+use serde::{Deserialize, Serialize};
+use std::fmt;
+
+/// A top-level scene.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Scene {
+    #[serde(default)]
+    pub render: Render,
+    pub camera: Camera,
+    #[serde(default)]
+    pub animation: Option<NotYetAnimation>,
+    #[serde(default)]
+    pub environment: Option<Environment>,
+    #[serde(default)]
+    pub entities: Vec<Entity>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Render {
+    #[serde(default = "default_width")]
+    pub width: ImageDim,
+    #[serde(default = "default_height")]
+    pub height: ImageDim,
+    #[serde(default = "default_spp")]
+    pub spp: Spp,
+    #[serde(default = "default_max_depth")]
+    pub max_depth: u32,
+    #[serde(default = "default_seed")]
+    pub seed: u64,
+    #[serde(default)]
+    pub integrator: IntegratorSettings,
+}
+
+fn default_width() -> ImageDim {
+    ImageDim(640)
+}
+fn default_height() -> ImageDim {
+    ImageDim(480)
+}
+fn default_spp() -> Spp {
+    Spp(64)
+}
+fn default_max_depth() -> u32 {
+    12
+}
+fn default_seed() -> u64 {
+    1
+}
+
+impl Default for Render {
+    fn default() -> Self {
+        Self {
+            width: default_width(),
+            height: default_height(),
+            spp: default_spp(),
+            max_depth: default_max_depth(),
+            seed: default_seed(),
+            integrator: IntegratorSettings::default(),
+        }
+    }
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct IntegratorSettings {
+    #[serde(default)]
+    pub light_sampling: LightSampling,
+    #[serde(default = "default_rr_depth")]
+    pub rr_depth: u32,
+    #[serde(default)]
+    pub fresnel: Fresnel,
+    #[serde(default = "default_wavelengths")]
+    pub wavelengths: Wavelengths,
+    #[serde(default)]
+    pub sampler: SamplerChoice,
+}
+
+fn default_rr_depth() -> u32 {
+    5
+}
+fn default_wavelengths() -> Wavelengths {
+    Wavelengths(4)
+}
+
+impl Default for IntegratorSettings {
+    fn default() -> Self {
+        Self {
+            light_sampling: LightSampling::default(),
+            rr_depth: default_rr_depth(),
+            fresnel: Fresnel::default(),
+            wavelengths: default_wavelengths(),
+            sampler: SamplerChoice::default(),
+        }
+    }
+}
+
+/// Next-event estimation with multiple importance sampling, or pure path tracing (emitters
+/// found only by chance).
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
+pub enum LightSampling {
+    #[default]
+    Nee,
+    Path,
+}
+
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
+pub enum Fresnel {
+    #[default]
+    Exact,
+    Schlick,
+}
+
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
+pub enum SamplerChoice {
+    #[default]
+    Sobol,
+    Independent,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Camera {
+    pub position: V3,
+    pub look_at: V3,
+    #[serde(default = "default_up")]
+    pub up: V3,
+    #[serde(default = "default_fov")]
+    pub fov_y: FovY,
+    #[serde(default)]
+    pub lens: Option<Lens>,
+    #[serde(default)]
+    pub shutter: Option<Shutter>,
+}
+
+fn default_up() -> V3 {
+    V3([0.0, 1.0, 0.0])
+}
+fn default_fov() -> FovY {
+    FovY(40.0)
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Lens {
+    pub aperture_radius: NonNegative,
+    pub focus_distance: Positive,
+    #[serde(default)]
+    pub blades: Blades,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields, try_from = "ShutterSpec")]
+pub struct Shutter {
+    pub open: f32,
+    pub close: f32,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct ShutterSpec {
+    open: f32,
+    close: f32,
+}
+
+impl TryFrom<ShutterSpec> for Shutter {
+    type Error = String;
+    fn try_from(s: ShutterSpec) -> Result<Self, String> {
+        if !(s.open.is_finite() && s.close.is_finite() && 0.0 <= s.open && s.open <= s.close && s.close <= 1.0) {
+            return Err(format!(
+                "shutter must satisfy 0 <= open <= close <= 1 (a fraction of a frame), got open {} close {}",
+                s.open, s.close
+            ));
+        }
+        Ok(Shutter {
+            open: s.open,
+            close: s.close,
+        })
+    }
+}
+
+/// Background radiance seen by escaping rays.
+#[derive(Clone, Debug, Deserialize)]
+pub enum Environment {
+    Constant(Emission),
+}
+
+/// One scene object.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Entity {
+    #[serde(default)]
+    pub name: Option<String>,
+    #[serde(default)]
+    pub shape: Option<Shape>,
+    #[serde(default)]
+    pub transform: Option<Transform>,
+    #[serde(default)]
+    pub material: Option<Material>,
+    #[serde(default)]
+    pub texture: Option<NotYetTexture>,
+    #[serde(default)]
+    pub motion: Option<NotYetMotion>,
+    #[serde(default)]
+    pub medium: Option<NotYetMedium>,
+    #[serde(default)]
+    pub light: Option<NotYetLight>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(try_from = "ShapeSpec")]
+pub enum Shape {
+    Sphere { center: V3, radius: Positive },
+    Rect { center: V3, u: V3, v: V3 },
+    Disk { center: V3, normal: V3, radius: Positive },
+    Box { min: V3, max: V3 },
+}
+
+#[derive(Deserialize)]
+enum ShapeSpec {
+    Sphere {
+        center: V3,
+        radius: Positive,
+    },
+    Rect {
+        center: V3,
+        u: V3,
+        v: V3,
+    },
+    Disk {
+        center: V3,
+        normal: V3,
+        radius: Positive,
+    },
+    Box {
+        min: V3,
+        max: V3,
+    },
+    Mesh {
+        #[allow(dead_code)]
+        path: IgnoredAny,
+    },
+    Revolution {
+        #[allow(dead_code)]
+        profile: IgnoredAny,
+    },
+}
+
+impl TryFrom<ShapeSpec> for Shape {
+    type Error = String;
+    fn try_from(s: ShapeSpec) -> Result<Self, String> {
+        Ok(match s {
+            ShapeSpec::Sphere { center, radius } => Shape::Sphere { center, radius },
+            ShapeSpec::Rect { center, u, v } => {
+                let (a, b) = (u.vec(), v.vec());
+                if a.cross(b).length_squared() <= 0.0 {
+                    return Err(format!(
+                        "Rect: u {:?} and v {:?} must be non-zero and not parallel (they span center ± u ± v)",
+                        u.0, v.0
+                    ));
+                }
+                Shape::Rect { center, u, v }
+            }
+            ShapeSpec::Disk {
+                center,
+                normal,
+                radius,
+            } => {
+                if normal.vec().length_squared() <= 0.0 {
+                    return Err("Disk: normal must be a non-zero vector".into());
+                }
+                Shape::Disk {
+                    center,
+                    normal,
+                    radius,
+                }
+            }
+            ShapeSpec::Box { min, max } => {
+                let (a, b) = (min.vec(), max.vec());
+                if !(a.x < b.x && a.y < b.y && a.z < b.z) {
+                    return Err(format!(
+                        "Box: min {:?} must be below max {:?} on every axis (a box needs a non-zero size)",
+                        min.0, max.0
+                    ));
+                }
+                Shape::Box { min, max }
+            }
+            ShapeSpec::Mesh { .. } => {
+                return Err("Mesh shapes are not supported by this build yet (triangle meshes)".into());
+            }
+            ShapeSpec::Revolution { .. } => {
+                return Err(
+                    "Revolution shapes are not supported by this build yet (surfaces of revolution)".into(),
+                );
+            }
+        })
+    }
+}
+
+/// Object-to-world placement: scale, then rotation R = Rz·Ry·Rx (degrees), then translation.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Transform {
+    #[serde(default)]
+    pub translate: Option<V3>,
+    #[serde(default)]
+    pub rotate: Option<V3>,
+    #[serde(default)]
+    pub scale: Option<Scale>,
+}
+
+#[derive(Clone, Debug, Deserialize)]
+pub enum Material {
+    Diffuse { albedo: Albedo },
+    Mirror { tint: Albedo },
+    Dielectric { ior: Ior },
+    Light {
+        emission: Emission,
+        #[serde(default)]
+        two_sided: bool,
+    },
+}
+
+/// Index of refraction. Only wavelength-independent IORs are simulated by this build.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(try_from = "IorSpec")]
+pub struct Ior(pub f32);
+
+#[derive(Deserialize)]
+enum IorSpec {
+    Constant(f32),
+    Cauchy {
+        #[allow(dead_code)]
+        a: IgnoredAny,
+        #[allow(dead_code)]
+        b: IgnoredAny,
+    },
+    Sellmeier {
+        #[allow(dead_code)]
+        b: IgnoredAny,
+        #[allow(dead_code)]
+        c: IgnoredAny,
+    },
+    Preset(#[allow(dead_code)] IgnoredAny),
+}
+
+impl TryFrom<IorSpec> for Ior {
+    type Error = String;
+    fn try_from(s: IorSpec) -> Result<Self, String> {
+        match s {
+            IorSpec::Constant(n) if n.is_finite() && n >= 1.0 => Ok(Ior(n)),
+            IorSpec::Constant(n) => Err(format!("ior must be a finite number >= 1, got {n}")),
+            _ => Err(
+                "wavelength-dependent IORs (Cauchy, Sellmeier, Preset) need spectral transport, \
+                 which this build does not have yet; use Constant(n)"
+                    .into(),
+            ),
+        }
+    }
+}
+
+/// Linear sRGB colour.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq)]
+pub enum Color {
+    Rgb(f32, f32, f32),
+}
+
+impl Color {
+    pub fn vec(&self) -> glam::Vec3 {
+        let Color::Rgb(r, g, b) = *self;
+        glam::Vec3::new(r, g, b)
+    }
+}
+
+/// A reflectance: every channel in [0, 1], so no surface creates energy.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(try_from = "Color")]
+pub struct Albedo(pub Color);
+
+impl TryFrom<Color> for Albedo {
+    type Error = String;
+    fn try_from(c: Color) -> Result<Self, String> {
+        let v = c.vec();
+        if v.is_finite() && v.min_element() >= 0.0 && v.max_element() <= 1.0 {
+            Ok(Albedo(c))
+        } else {
+            Err(format!(
+                "a reflectance must have every channel in [0, 1], got Rgb({}, {}, {})",
+                v.x, v.y, v.z
+            ))
+        }
+    }
+}
+
+/// Emitted radiance.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(try_from = "EmissionSpec")]
+pub struct Emission(pub Color);
+
+#[derive(Deserialize)]
+enum EmissionSpec {
+    Rgb(f32, f32, f32),
+    Blackbody {
+        #[allow(dead_code)]
+        kelvin: IgnoredAny,
+        #[allow(dead_code)]
+        scale: IgnoredAny,
+    },
+    Illuminant {
+        #[allow(dead_code)]
+        spectrum: IgnoredAny,
+        #[allow(dead_code)]
+        scale: IgnoredAny,
+    },
+}
+
+impl TryFrom<EmissionSpec> for Emission {
+    type Error = String;
+    fn try_from(s: EmissionSpec) -> Result<Self, String> {
+        match s {
+            EmissionSpec::Rgb(r, g, b) => {
+                if [r, g, b].iter().all(|c| c.is_finite() && *c >= 0.0) {
+                    Ok(Emission(Color::Rgb(r, g, b)))
+                } else {
+                    Err(format!(
+                        "emission must be finite and >= 0 in every channel, got Rgb({r}, {g}, {b})"
+                    ))
+                }
+            }
+            _ => Err("spectral emitters (Blackbody, Illuminant) need spectral transport, \
+                      which this build does not have yet; use Rgb(r, g, b)"
+                .into()),
+        }
+    }
+}
+
+/// A finite 3-vector written `(x, y, z)`.
+#[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
+#[serde(try_from = "(f32, f32, f32)")]
+pub struct V3(pub [f32; 3]);
+
+impl V3 {
+    pub fn vec(&self) -> glam::Vec3 {
+        glam::Vec3::from_array(self.0)
+    }
+}
+
+impl TryFrom<(f32, f32, f32)> for V3 {
+    type Error = String;
+    fn try_from((x, y, z): (f32, f32, f32)) -> Result<Self, String> {
+        if x.is_finite() && y.is_finite() && z.is_finite() {
+            Ok(V3([x, y, z]))
+        } else {
+            Err(format!("coordinates must be finite, got ({x}, {y}, {z})"))
+        }
+    }
+}
+
+macro_rules! checked_number {
+    ($(#[$doc:meta])* $name:ident($t:ty, $tstr:literal), $ok:expr, $what:literal) => {
+        $(#[$doc])*
+        #[derive(Clone, Copy, Debug, Deserialize, PartialEq)]
+        #[serde(try_from = $tstr)]
+        pub struct $name(pub $t);
+
+        impl TryFrom<$t> for $name {
+            type Error = String;
+            fn try_from(x: $t) -> Result<Self, String> {
+                #[allow(clippy::redundant_closure_call)]
+                if ($ok)(x) {
+                    Ok($name(x))
+                } else {
+                    Err(format!(concat!("must be ", $what, ", got {}"), x))
+                }
+            }
+        }
+    };
+}
+
+checked_number!(
+    /// A finite number > 0.
+    Positive(f32, "f32"), |x: f32| x.is_finite() && x > 0.0, "a finite number > 0");
+checked_number!(
+    /// A finite number >= 0.
+    NonNegative(f32, "f32"), |x: f32| x.is_finite() && x >= 0.0, "a finite number >= 0");
+checked_number!(
+    /// Vertical field of view in degrees.
+    FovY(f32, "f32"), |x: f32| x.is_finite() && x > 0.0 && x < 180.0, "in (0, 180) degrees");
+checked_number!(
+    /// Image width or height in pixels.
+    ImageDim(u32, "u32"), |x: u32| (1..=65536).contains(&x), "in 1..=65536 pixels");
+checked_number!(
+    /// Samples per pixel.
+    Spp(u32, "u32"), |x: u32| x >= 1, "at least 1 sample per pixel");
+checked_number!(
+    /// Number of aperture blades: 0 for a round aperture, otherwise at least 3.
+    Blades(u32, "u32"), |x: u32| x == 0 || (3..=64).contains(&x), "0 (round) or 3..=64");
+checked_number!(
+    /// Wavelengths carried per path in spectral mode.
+    Wavelengths(u32, "u32"), |x: u32| (1..=4).contains(&x), "1..=4");
+
+impl Default for Blades {
+    fn default() -> Self {
+        Blades(0)
+    }
+}
+
+/// `scale: 2.0` or `scale: (1.0, 2.0, 1.0)`; every component non-zero and finite.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Scale(pub [f32; 3]);
+
+impl<'de> Deserialize<'de> for Scale {
+    fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> Visitor<'de> for V {
+            type Value = Scale;
+            fn expecting(&self, f: &mut fmt::Formatter) -> fmt::Result {
+                f.write_str("a number or a triple (x, y, z)")
+            }
+            fn visit_f64<E: de::Error>(self, x: f64) -> Result<Scale, E> {
+                check_scale([x as f32; 3])
+            }
+            fn visit_i64<E: de::Error>(self, x: i64) -> Result<Scale, E> {
+                check_scale([x as f32; 3])
+            }
+            fn visit_u64<E: de::Error>(self, x: u64) -> Result<Scale, E> {
+                check_scale([x as f32; 3])
+            }
+            fn visit_seq<A: SeqAccess<'de>>(self, mut seq: A) -> Result<Scale, A::Error> {
+                let mut s = [0.0f32; 3];
+                for (i, c) in s.iter_mut().enumerate() {
+                    *c = seq
+                        .next_element()?
+                        .ok_or_else(|| de::Error::invalid_length(i, &self))?;
+                }
+                if seq.next_element::<IgnoredAny>()?.is_some() {
+                    return Err(de::Error::invalid_length(4, &self));
+                }
+                check_scale(s)
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+fn check_scale<E: de::Error>(s: [f32; 3]) -> Result<Scale, E> {
+    if s.iter().all(|c| c.is_finite() && *c != 0.0) {
+        Ok(Scale(s))
+    } else {
+        Err(E::custom(format!(
+            "scale must be finite and non-zero on every axis, got ({}, {}, {})",
+            s[0], s[1], s[2]
+        )))
+    }
+}
+
+macro_rules! not_yet {
+    ($name:ident, $field:literal, $feature:literal) => {
+        /// Parsed so that it can be refused with a located message.
+        #[derive(Clone, Debug)]
+        pub struct $name;
+
+        impl<'de> Deserialize<'de> for $name {
+            fn deserialize<D: Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+                IgnoredAny::deserialize(d)?;
+                Err(de::Error::custom(concat!(
+                    "`",
+                    $field,
+                    "` is not supported by this build yet (",
+                    $feature,
+                    ")"
+                )))
+            }
+        }
+    };
+}
+
+not_yet!(NotYetAnimation, "animation", "animated camera sequences");
+not_yet!(NotYetTexture, "texture", "textures and normal maps");
+not_yet!(NotYetMotion, "motion", "motion blur");
+not_yet!(NotYetMedium, "medium", "participating media");
+not_yet!(NotYetLight, "light", "point and spot lights");

@@ -1,0 +1,158 @@
+//! `gather_lights`: the emitters, chosen by power through an alias table.
+
+use super::primitives::{PrimKind, Primitives, emitted};
+use crate::geometry::Aabb;
+use crate::sampling::AliasTable;
+use glam::{Vec2, Vec3};
+
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum LightKind {
+    /// An emissive primitive (Sphere, Rect or Disk), by primitive index.
+    Area(u32),
+    /// The constant environment: radiance from every direction.
+    Environment(Vec3),
+}
+
+/// A light sample as seen from a reference point.
+#[derive(Clone, Copy, Debug)]
+pub struct LightSample {
+    /// Unit direction towards the light.
+    pub wi: Vec3,
+    /// The sampled point and its normal (area lights); `None` for the environment.
+    pub point: Option<(Vec3, Vec3)>,
+    /// Radiance arriving along `-wi`.
+    pub radiance: Vec3,
+    /// Solid-angle density, including the probability of choosing this light.
+    pub pdf: f32,
+}
+
+pub struct Lights {
+    pub lights: Vec<LightKind>,
+    table: AliasTable,
+    /// Index of the environment light, if the environment emits.
+    pub environment: Option<u32>,
+}
+
+impl Lights {
+    pub fn is_empty(&self) -> bool {
+        self.lights.is_empty()
+    }
+
+    /// Chooses a light by power and samples a direction to it from `p`.
+    #[inline]
+    pub fn sample(&self, prims: &Primitives, p: Vec3, u_select: f32, u: Vec2) -> Option<LightSample> {
+        if self.lights.is_empty() {
+            return None;
+        }
+        let (i, pmf) = self.table.sample(u_select);
+        match self.lights[i] {
+            LightKind::Environment(l) => {
+                let wi = crate::sampling::square_to_uniform_sphere(u);
+                Some(LightSample {
+                    wi,
+                    point: None,
+                    radiance: l,
+                    pdf: pmf * crate::sampling::uniform_sphere_pdf(),
+                })
+            }
+            LightKind::Area(prim) => {
+                let l = prims.local[prim as usize] as usize;
+                let s = match prims.kind[prim as usize] {
+                    PrimKind::Sphere => prims.spheres[l].sample(p, u),
+                    PrimKind::Rect => prims.planars[l].sample(p, u, false),
+                    PrimKind::Disk => prims.planars[l].sample(p, u, true),
+                    PrimKind::Box => None,
+                }?;
+                let d = s.p - p;
+                let wi = d.normalize_or_zero();
+                let m = &prims.materials[prims.material[prim as usize] as usize];
+                let radiance = emitted(m, s.n, -wi);
+                (wi != Vec3::ZERO && radiance != Vec3::ZERO).then_some(LightSample {
+                    wi,
+                    point: Some((s.p, s.n)),
+                    radiance,
+                    pdf: pmf * s.pdf,
+                })
+            }
+        }
+    }
+
+    /// Density with which `sample` from `p` would have produced the point `q` (normal `n`)
+    /// on emissive primitive `prim`: needed to weight emitters found by chance.
+    #[inline]
+    pub fn pdf_area(&self, prims: &Primitives, prim: u32, p: Vec3, q: Vec3, n: Vec3) -> f32 {
+        let li = prims.light[prim as usize];
+        let pmf = self.table.pmf(li as usize);
+        let l = prims.local[prim as usize] as usize;
+        pmf * match prims.kind[prim as usize] {
+            PrimKind::Sphere => prims.spheres[l].pdf(p, q, n),
+            PrimKind::Rect | PrimKind::Disk => prims.planars[l].pdf(p, q),
+            PrimKind::Box => 0.0,
+        }
+    }
+
+    /// Density of sampling direction `wi` towards the environment.
+    #[inline]
+    pub fn pdf_environment(&self) -> f32 {
+        self.environment.map_or(0.0, |i| {
+            self.table.pmf(i as usize) * crate::sampling::uniform_sphere_pdf()
+        })
+    }
+}
+
+fn luminance(c: Vec3) -> f32 {
+    0.2126 * c.x + 0.7152 * c.y + 0.0722 * c.z
+}
+
+/// Collects the emitters and builds the power-proportional selection table. Records each
+/// emitter's light index on its primitive, so a path that hits it by chance finds its pdf.
+pub fn gather_lights(prims: &mut Primitives, environment: Vec3, scene_bounds: &Aabb) -> Lights {
+    let mut lights = Vec::new();
+    let mut power = Vec::new();
+    for i in 0..prims.len() {
+        let m = prims.materials[prims.material[i] as usize];
+        if !m.is_emissive() {
+            continue;
+        }
+        let l = prims.local[i] as usize;
+        let area = match prims.kind[i] {
+            PrimKind::Sphere => prims.spheres[l].area(),
+            PrimKind::Rect | PrimKind::Disk => prims.planars[l].area(),
+            PrimKind::Box => continue,
+        };
+        let (e, sides) = match m {
+            crate::components::Material::Light {
+                emission,
+                two_sided,
+            } => (emission, if two_sided { 2.0 } else { 1.0 }),
+            _ => unreachable!("is_emissive"),
+        };
+        prims.light[i] = lights.len() as u32;
+        lights.push(LightKind::Area(i as u32));
+        power.push(std::f32::consts::PI * area * sides * luminance(e).max(1e-6));
+    }
+    let mut env_index = None;
+    if environment.max_element() > 0.0 {
+        // As pbrt does, the environment's power is that of a disc the size of the scene
+        // facing it from every direction.
+        let r = if scene_bounds.is_empty() {
+            1.0
+        } else {
+            0.5 * scene_bounds.diagonal().length()
+        };
+        env_index = Some(lights.len() as u32);
+        lights.push(LightKind::Environment(environment));
+        power.push(
+            4.0 * std::f32::consts::PI
+                * std::f32::consts::PI
+                * r
+                * r
+                * luminance(environment).max(1e-6),
+        );
+    }
+    Lights {
+        table: AliasTable::new(&power),
+        lights,
+        environment: env_index,
+    }
+}

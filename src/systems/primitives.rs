@@ -1,0 +1,182 @@
+//! `gather_primitives`: flattens the world's shapes into per-kind arrays for the hot loop,
+//! keeping each primitive's entity for messages and statistics.
+
+use crate::components::{Material, Name, Shape, Transform};
+use crate::geometry::{Aabb, OrientedBox, Planar, Ray, Sphere, SurfacePoint};
+use crate::kdtree::KdPrimitives;
+use glam::Vec3;
+
+/// The closed list of primitive kinds; the hot loop matches on it once per test.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+#[repr(u8)]
+pub enum PrimKind {
+    Sphere,
+    Rect,
+    Disk,
+    Box,
+}
+
+/// What the intersect stage records: small, so the stage streams through memory.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Hit {
+    pub t: f32,
+    pub prim: u32,
+    pub u: f32,
+    pub v: f32,
+}
+
+pub const NO_LIGHT: u32 = u32::MAX;
+
+/// Structure-of-arrays primitive store. Index `i` addresses `kind`, `local`, `material`,
+/// `light` and `entity`; `local[i]` indexes the array of its kind.
+#[derive(Default)]
+pub struct Primitives {
+    pub kind: Vec<PrimKind>,
+    pub local: Vec<u32>,
+    pub material: Vec<u32>,
+    /// Index into the light list when the primitive emits, else `NO_LIGHT`.
+    pub light: Vec<u32>,
+    pub entity: Vec<hecs::Entity>,
+    pub spheres: Vec<Sphere>,
+    pub planars: Vec<Planar>,
+    pub boxes: Vec<OrientedBox>,
+    pub materials: Vec<Material>,
+    pub names: Vec<String>,
+}
+
+impl Primitives {
+    pub fn len(&self) -> usize {
+        self.kind.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.kind.is_empty()
+    }
+
+    pub fn bounds_of(&self, i: u32) -> Aabb {
+        let l = self.local[i as usize] as usize;
+        match self.kind[i as usize] {
+            PrimKind::Sphere => self.spheres[l].bounds(),
+            PrimKind::Rect => self.planars[l].bounds(false),
+            PrimKind::Disk => self.planars[l].bounds(true),
+            PrimKind::Box => self.boxes[l].bounds(),
+        }
+    }
+
+    /// Intersects primitive `i`: `Some((t, u, v))` for a hit in (0, t_max).
+    #[inline]
+    pub fn intersect(&self, i: u32, ray: &Ray, t_max: f32) -> Option<(f32, f32, f32)> {
+        let l = self.local[i as usize] as usize;
+        match self.kind[i as usize] {
+            PrimKind::Sphere => self.spheres[l].intersect(ray, t_max).map(|t| (t, 0.0, 0.0)),
+            PrimKind::Rect => self.planars[l].intersect(ray, t_max, false),
+            PrimKind::Disk => self.planars[l].intersect(ray, t_max, true),
+            PrimKind::Box => self.boxes[l].intersect(ray, t_max).map(|t| (t, 0.0, 0.0)),
+        }
+    }
+
+    /// Full surface data, computed for the winning hit only.
+    #[inline]
+    pub fn surface(&self, ray: &Ray, hit: &Hit) -> SurfacePoint {
+        let l = self.local[hit.prim as usize] as usize;
+        match self.kind[hit.prim as usize] {
+            PrimKind::Sphere => self.spheres[l].surface(ray, hit.t),
+            PrimKind::Rect | PrimKind::Disk => self.planars[l].surface(hit.u, hit.v),
+            PrimKind::Box => self.boxes[l].surface(ray, hit.t),
+        }
+    }
+
+    /// Number of primitives of each kind, for `prism info`.
+    pub fn counts(&self) -> [(PrimKind, usize); 4] {
+        let n = |k| self.kind.iter().filter(|&&x| x == k).count();
+        [
+            (PrimKind::Sphere, n(PrimKind::Sphere)),
+            (PrimKind::Rect, n(PrimKind::Rect)),
+            (PrimKind::Disk, n(PrimKind::Disk)),
+            (PrimKind::Box, n(PrimKind::Box)),
+        ]
+    }
+}
+
+impl KdPrimitives for Primitives {
+    fn len(&self) -> usize {
+        self.kind.len()
+    }
+
+    fn bounds(&self, i: u32) -> Aabb {
+        self.bounds_of(i)
+    }
+}
+
+/// Flattens every entity with a `Shape` into world-space primitives. Entities are taken in
+/// spawn order so primitive indices, and thus images, are reproducible.
+pub fn gather_primitives(world: &hecs::World) -> Primitives {
+    let mut p = Primitives::default();
+    let mut rows: Vec<(hecs::Entity, Shape, Transform, Material, String)> = world
+        .query::<(hecs::Entity, &Shape, &Transform, &Material, &Name)>()
+        .iter()
+        .map(|(e, s, t, m, n)| (e, *s, *t, *m, n.0.clone()))
+        .collect();
+    rows.sort_by_key(|r| r.0.id());
+    for (entity, shape, transform, material, name) in rows {
+        let m = p.materials.len() as u32;
+        p.materials.push(material);
+        let tw = transform.to_world;
+        let (kind, local) = match shape {
+            Shape::Sphere { center, radius } => {
+                let scale = transform.uniform_scale.unwrap_or(1.0);
+                p.spheres.push(Sphere {
+                    center: tw.transform_point3(center),
+                    radius: radius * scale,
+                });
+                (PrimKind::Sphere, p.spheres.len() - 1)
+            }
+            Shape::Rect { center, u, v } => {
+                p.planars.push(Planar::new(
+                    tw.transform_point3(center),
+                    tw.transform_vector3(u),
+                    tw.transform_vector3(v),
+                    false,
+                ));
+                (PrimKind::Rect, p.planars.len() - 1)
+            }
+            Shape::Disk {
+                center,
+                normal,
+                radius,
+            } => {
+                let (t, b) = crate::sampling::coordinate_system(normal);
+                p.planars.push(Planar::new(
+                    tw.transform_point3(center),
+                    tw.transform_vector3(t * radius),
+                    tw.transform_vector3(b * radius),
+                    true,
+                ));
+                (PrimKind::Disk, p.planars.len() - 1)
+            }
+            Shape::Box { min, max } => {
+                p.boxes.push(OrientedBox::new(min, max, tw));
+                (PrimKind::Box, p.boxes.len() - 1)
+            }
+        };
+        p.kind.push(kind);
+        p.local.push(local as u32);
+        p.material.push(m);
+        p.light.push(NO_LIGHT);
+        p.entity.push(entity);
+        p.names.push(name);
+    }
+    p
+}
+
+/// Radiance leaving an emissive primitive towards `wo` from a point with normal `n`.
+#[inline]
+pub fn emitted(material: &Material, n: Vec3, wo: Vec3) -> Vec3 {
+    match *material {
+        Material::Light {
+            emission,
+            two_sided,
+        } if two_sided || n.dot(wo) > 0.0 => emission,
+        _ => Vec3::ZERO,
+    }
+}

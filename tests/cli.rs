@@ -1,0 +1,142 @@
+//! The command line on good and bad input: bad input exits non-zero with one located line.
+
+use assert_cmd::Command;
+use std::path::Path;
+
+fn prism() -> Command {
+    Command::cargo_bin("prism").unwrap()
+}
+
+fn write(dir: &Path, name: &str, text: &str) -> std::path::PathBuf {
+    let p = dir.join(name);
+    std::fs::write(&p, text).unwrap();
+    p
+}
+
+const GOOD: &str = r#"Scene(
+    render: (width: 8, height: 6, spp: 2),
+    camera: (position: (0.0, 0.0, 4.0), look_at: (0.0, 0.0, 0.0)),
+    environment: Constant(Rgb(0.5, 0.5, 0.5)),
+    entities: [
+        (name: "ball", shape: Sphere(center: (0.0, 0.0, 0.0), radius: 1.0),
+         material: Diffuse(albedo: Rgb(0.5, 0.5, 0.5))),
+    ],
+)"#;
+
+/// Runs `prism ARGS` and returns stderr, asserting failure and a single-line message.
+fn fails(args: &[&str]) -> String {
+    let out = prism().args(args).output().unwrap();
+    assert!(!out.status.success(), "{args:?} should fail");
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert_eq!(err.trim_end().lines().count(), 1, "one line: {err}");
+    assert!(!err.contains("panicked"), "{err}");
+    err
+}
+
+#[test]
+fn renders_png_and_exr() {
+    let d = tempfile::tempdir().unwrap();
+    let scene = write(d.path(), "s.ron", GOOD);
+    for name in ["out.png", "out.exr"] {
+        let out = d.path().join(name);
+        prism()
+            .args(["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--quiet"])
+            .assert()
+            .success();
+        let (img, meta) = prism::film::read_image(&out).unwrap();
+        assert_eq!((img.width, img.height), (8, 6));
+        if name.ends_with("exr") {
+            assert_eq!(meta.unwrap().spp, 2);
+        }
+    }
+    let names: Vec<_> = std::fs::read_dir(d.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+    assert_eq!(names.len(), 3, "no temporary files left: {names:?}");
+}
+
+#[test]
+fn info_prints_the_effects_manifest() {
+    let d = tempfile::tempdir().unwrap();
+    let scene = write(d.path(), "s.ron", GOOD);
+    let out = prism().args(["info", scene.to_str().unwrap()]).output().unwrap();
+    assert!(out.status.success());
+    let s = String::from_utf8(out.stdout).unwrap();
+    for e in ["LENS: off (", "MOTION: off (", "SPECTRAL: off (", "MEDIA: off (", "TEXTURES: off (", "NORMAL_MAPS: off ("] {
+        assert!(s.contains(e), "{e} missing in\n{s}");
+    }
+    assert!(s.contains("kd-tree:"));
+}
+
+#[test]
+fn syntax_error_names_file_line_and_column() {
+    let d = tempfile::tempdir().unwrap();
+    let scene = write(d.path(), "bad.ron", &GOOD.replace("spp: 2)", "spp: 2"));
+    let err = fails(&["render", scene.to_str().unwrap()]);
+    assert!(err.contains("bad.ron:"), "{err}");
+    assert!(err.split(':').nth(2).is_some_and(|l| l.trim().parse::<u32>().is_ok()), "{err}");
+}
+
+#[test]
+fn unknown_field_is_refused_with_its_name() {
+    let d = tempfile::tempdir().unwrap();
+    let scene = write(d.path(), "s.ron", &GOOD.replace("radius: 1.0", "radius: 1.0, colour: 3"));
+    let err = fails(&["render", scene.to_str().unwrap()]);
+    assert!(err.contains("s.ron:6:"), "{err}");
+    assert!(err.contains("colour"), "{err}");
+    assert!(err.contains("entity \"ball\""), "{err}");
+}
+
+#[test]
+fn negative_radius_names_entity_field_and_range() {
+    let d = tempfile::tempdir().unwrap();
+    let scene = write(d.path(), "s.ron", &GOOD.replace("radius: 1.0", "radius: -1.0"));
+    let err = fails(&["render", scene.to_str().unwrap()]);
+    assert!(err.contains("s.ron:6:"), "{err}");
+    assert!(err.contains("entity \"ball\""), "{err}");
+    assert!(err.contains("radius"), "{err}");
+    assert!(err.contains("> 0"), "{err}");
+}
+
+#[test]
+fn zero_size_image_is_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let scene = write(d.path(), "s.ron", &GOOD.replace("width: 8", "width: 0"));
+    let err = fails(&["render", scene.to_str().unwrap()]);
+    assert!(err.contains("s.ron:2:") && err.contains("width"), "{err}");
+    let good = write(d.path(), "g.ron", GOOD);
+    let err = fails(&["render", good.to_str().unwrap(), "--size", "0x10"]);
+    assert!(err.contains("1..=65536"), "{err}");
+}
+
+#[test]
+fn missing_scene_file_names_the_path() {
+    let err = fails(&["render", "/nonexistent/scene.ron"]);
+    assert!(err.contains("/nonexistent/scene.ron"), "{err}");
+}
+
+#[test]
+fn unsupported_features_are_refused_not_ignored() {
+    let d = tempfile::tempdir().unwrap();
+    let scene = write(
+        d.path(),
+        "s.ron",
+        &GOOD.replace("material: Diffuse(albedo: Rgb(0.5, 0.5, 0.5))", "material: Dielectric(ior: Cauchy(a: 1.5, b: 0.004))"),
+    );
+    let err = fails(&["render", scene.to_str().unwrap()]);
+    assert!(err.contains("spectral"), "{err}");
+    let err = fails(&["render", write(d.path(), "g.ron", GOOD).to_str().unwrap(), "--set", "render.nonsense=3"]);
+    assert!(err.contains("unknown key"), "{err}");
+}
+
+#[test]
+fn set_overrides_a_value() {
+    let d = tempfile::tempdir().unwrap();
+    let scene = write(d.path(), "s.ron", GOOD);
+    let out = d.path().join("o.exr");
+    prism()
+        .args(["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--quiet", "--set", "render.spp=3"])
+        .assert()
+        .success();
+    assert_eq!(prism::film::read_image(&out).unwrap().1.unwrap().spp, 3);
+    let err = fails(&["render", scene.to_str().unwrap(), "--set", "render.integrator.fresnel=Wrong"]);
+    assert!(err.contains("render.integrator.fresnel"), "{err}");
+}

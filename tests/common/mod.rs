@@ -1,0 +1,5 @@
+// Each test binary uses only part of the shared helpers.
+#![allow(dead_code)]
+
+pub mod chi2;
+pub mod render;

@@ -1,0 +1,52 @@
+//! Rendering helpers shared by the integration tests.
+
+use prism::film::Image;
+use prism::integrator::{Integrator, RenderOptions, RenderOutput, render};
+use prism::kdtree::KdParams;
+use prism::scene_file::load_str;
+use prism::systems::{RenderScene, prepare};
+use std::path::Path;
+
+/// Parses scene text (as if it lived in `scenes/`) and runs the systems.
+pub fn scene(text: &str) -> RenderScene {
+    let loaded = load_str(text, Path::new("scenes/test.ron"), &[]).expect("test scene parses");
+    prepare(&loaded, &KdParams::default())
+}
+
+pub fn scene_file(path: &Path, overrides: &[(&str, &str)]) -> RenderScene {
+    let o: Vec<(String, String)> = overrides
+        .iter()
+        .map(|(k, v)| (k.to_string(), v.to_string()))
+        .collect();
+    let loaded = prism::scene_file::load(path, &o).expect("scene loads");
+    prepare(&loaded, &KdParams::default())
+}
+
+pub fn run(scene: &RenderScene, integrator: Integrator) -> RenderOutput {
+    let opts = RenderOptions {
+        sample_offset: 0,
+        spp: scene.settings.spp,
+        time_limit: None,
+        integrator,
+    };
+    render(scene, &opts, &|_| {})
+}
+
+pub fn image(text: &str) -> Image {
+    run(&scene(text), Integrator::Wavefront).image()
+}
+
+/// Mean of one channel over the pixels selected by `keep(x, y)`.
+pub fn mean_where(img: &Image, c: usize, keep: impl Fn(u32, u32) -> bool) -> f64 {
+    let (mut s, mut n) = (0.0, 0usize);
+    for y in 0..img.height {
+        for x in 0..img.width {
+            if keep(x, y) {
+                s += img.pixels[(y * img.width + x) as usize][c] as f64;
+                n += 1;
+            }
+        }
+    }
+    assert!(n > 0, "no pixel selected");
+    s / n as f64
+}
