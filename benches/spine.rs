@@ -17,7 +17,10 @@ fn cornell(size: u32, spp: u32) -> RenderScene {
         ("render.height".to_string(), size.to_string()),
         ("render.spp".to_string(), spp.to_string()),
     ];
-    prepare(&prism::scene_file::load(&path, &o).unwrap(), &KdParams::default())
+    prepare(
+        &prism::scene_file::load(&path, &o).unwrap(),
+        &KdParams::default(),
+    )
 }
 
 fn random_boxes(n: usize) -> Vec<Aabb> {
@@ -41,12 +44,17 @@ fn kdtree(c: &mut Criterion) {
     let s = Sampler::new(SamplerKind::Independent, 3);
     let rays: Vec<Ray> = (0..4096u32)
         .map(|i| {
-            let o = Vec3::new(278.0, 273.0, 250.0) + square_to_uniform_sphere(s.get_2d(i, 0, 0)) * 100.0;
+            let o = Vec3::new(278.0, 273.0, 250.0)
+                + square_to_uniform_sphere(s.get_2d(i, 0, 0)) * 100.0;
             Ray::new(o, square_to_uniform_sphere(s.get_2d(i, 0, 2)))
         })
         .collect();
     g.bench_function("closest_hit_cornell_4096", |b| {
-        b.iter(|| rays.iter().filter(|r| scene.intersect(r, f32::INFINITY).is_some()).count())
+        b.iter(|| {
+            rays.iter()
+                .filter(|r| scene.intersect(r, f32::INFINITY).is_some())
+                .count()
+        })
     });
     g.bench_function("any_hit_cornell_4096", |b| {
         b.iter(|| rays.iter().filter(|r| scene.occluded(r, 300.0)).count())
@@ -79,7 +87,10 @@ fn integrator(c: &mut Criterion) {
     let mut g = c.benchmark_group("integrator");
     g.sample_size(10);
     let scene = cornell(64, 4);
-    for (name, integrator) in [("wavefront", Integrator::Wavefront), ("reference", Integrator::Reference)] {
+    for (name, integrator) in [
+        ("wavefront", Integrator::Wavefront),
+        ("reference", Integrator::Reference),
+    ] {
         let opts = RenderOptions {
             sample_offset: 0,
             spp: 4,

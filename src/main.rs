@@ -16,7 +16,22 @@ fn main() -> ExitCode {
             .unwrap_or_default();
         eprintln!("error: internal error: {msg}{at}");
     }));
-    let cli = prism::cli::Cli::parse();
+    let cli = match prism::cli::Cli::try_parse() {
+        Ok(c) => c,
+        Err(e) if !e.use_stderr() => {
+            // --help and --version.
+            let _ = e.print();
+            return ExitCode::SUCCESS;
+        }
+        Err(e) => {
+            // clap's message is the first line; the usage block after it is noise here.
+            let text = e.to_string();
+            let first = text.lines().next().unwrap_or("invalid arguments");
+            let first = first.strip_prefix("error: ").unwrap_or(first);
+            eprintln!("error: {first} (see 'prism --help')");
+            return ExitCode::from(2);
+        }
+    };
     match prism::cli::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {

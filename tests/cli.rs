@@ -40,7 +40,13 @@ fn renders_png_and_exr() {
     for name in ["out.png", "out.exr"] {
         let out = d.path().join(name);
         prism()
-            .args(["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--quiet"])
+            .args([
+                "render",
+                scene.to_str().unwrap(),
+                "-o",
+                out.to_str().unwrap(),
+                "--quiet",
+            ])
             .assert()
             .success();
         let (img, meta) = prism::film::read_image(&out).unwrap();
@@ -49,7 +55,10 @@ fn renders_png_and_exr() {
             assert_eq!(meta.unwrap().spp, 2);
         }
     }
-    let names: Vec<_> = std::fs::read_dir(d.path()).unwrap().map(|e| e.unwrap().file_name()).collect();
+    let names: Vec<_> = std::fs::read_dir(d.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
     assert_eq!(names.len(), 3, "no temporary files left: {names:?}");
 }
 
@@ -57,10 +66,20 @@ fn renders_png_and_exr() {
 fn info_prints_the_effects_manifest() {
     let d = tempfile::tempdir().unwrap();
     let scene = write(d.path(), "s.ron", GOOD);
-    let out = prism().args(["info", scene.to_str().unwrap()]).output().unwrap();
+    let out = prism()
+        .args(["info", scene.to_str().unwrap()])
+        .output()
+        .unwrap();
     assert!(out.status.success());
     let s = String::from_utf8(out.stdout).unwrap();
-    for e in ["LENS: off (", "MOTION: off (", "SPECTRAL: off (", "MEDIA: off (", "TEXTURES: off (", "NORMAL_MAPS: off ("] {
+    for e in [
+        "LENS: off (",
+        "MOTION: off (",
+        "SPECTRAL: off (",
+        "MEDIA: off (",
+        "TEXTURES: off (",
+        "NORMAL_MAPS: off (",
+    ] {
         assert!(s.contains(e), "{e} missing in\n{s}");
     }
     assert!(s.contains("kd-tree:"));
@@ -72,13 +91,22 @@ fn syntax_error_names_file_line_and_column() {
     let scene = write(d.path(), "bad.ron", &GOOD.replace("spp: 2)", "spp: 2"));
     let err = fails(&["render", scene.to_str().unwrap()]);
     assert!(err.contains("bad.ron:"), "{err}");
-    assert!(err.split(':').nth(2).is_some_and(|l| l.trim().parse::<u32>().is_ok()), "{err}");
+    assert!(
+        err.split(':')
+            .nth(2)
+            .is_some_and(|l| l.trim().parse::<u32>().is_ok()),
+        "{err}"
+    );
 }
 
 #[test]
 fn unknown_field_is_refused_with_its_name() {
     let d = tempfile::tempdir().unwrap();
-    let scene = write(d.path(), "s.ron", &GOOD.replace("radius: 1.0", "radius: 1.0, colour: 3"));
+    let scene = write(
+        d.path(),
+        "s.ron",
+        &GOOD.replace("radius: 1.0", "radius: 1.0, colour: 3"),
+    );
     let err = fails(&["render", scene.to_str().unwrap()]);
     assert!(err.contains("s.ron:6:"), "{err}");
     assert!(err.contains("colour"), "{err}");
@@ -88,7 +116,11 @@ fn unknown_field_is_refused_with_its_name() {
 #[test]
 fn negative_radius_names_entity_field_and_range() {
     let d = tempfile::tempdir().unwrap();
-    let scene = write(d.path(), "s.ron", &GOOD.replace("radius: 1.0", "radius: -1.0"));
+    let scene = write(
+        d.path(),
+        "s.ron",
+        &GOOD.replace("radius: 1.0", "radius: -1.0"),
+    );
     let err = fails(&["render", scene.to_str().unwrap()]);
     assert!(err.contains("s.ron:6:"), "{err}");
     assert!(err.contains("entity \"ball\""), "{err}");
@@ -119,11 +151,19 @@ fn unsupported_features_are_refused_not_ignored() {
     let scene = write(
         d.path(),
         "s.ron",
-        &GOOD.replace("material: Diffuse(albedo: Rgb(0.5, 0.5, 0.5))", "material: Dielectric(ior: Cauchy(a: 1.5, b: 0.004))"),
+        &GOOD.replace(
+            "material: Diffuse(albedo: Rgb(0.5, 0.5, 0.5))",
+            "material: Dielectric(ior: Cauchy(a: 1.5, b: 0.004))",
+        ),
     );
     let err = fails(&["render", scene.to_str().unwrap()]);
     assert!(err.contains("spectral"), "{err}");
-    let err = fails(&["render", write(d.path(), "g.ron", GOOD).to_str().unwrap(), "--set", "render.nonsense=3"]);
+    let err = fails(&[
+        "render",
+        write(d.path(), "g.ron", GOOD).to_str().unwrap(),
+        "--set",
+        "render.nonsense=3",
+    ]);
     assert!(err.contains("unknown key"), "{err}");
 }
 
@@ -133,10 +173,23 @@ fn set_overrides_a_value() {
     let scene = write(d.path(), "s.ron", GOOD);
     let out = d.path().join("o.exr");
     prism()
-        .args(["render", scene.to_str().unwrap(), "-o", out.to_str().unwrap(), "--quiet", "--set", "render.spp=3"])
+        .args([
+            "render",
+            scene.to_str().unwrap(),
+            "-o",
+            out.to_str().unwrap(),
+            "--quiet",
+            "--set",
+            "render.spp=3",
+        ])
         .assert()
         .success();
     assert_eq!(prism::film::read_image(&out).unwrap().1.unwrap().spp, 3);
-    let err = fails(&["render", scene.to_str().unwrap(), "--set", "render.integrator.fresnel=Wrong"]);
+    let err = fails(&[
+        "render",
+        scene.to_str().unwrap(),
+        "--set",
+        "render.integrator.fresnel=Wrong",
+    ]);
     assert!(err.contains("render.integrator.fresnel"), "{err}");
 }

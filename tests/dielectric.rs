@@ -64,11 +64,11 @@ fn total_internal_reflection_past_the_critical_angle() {
 
 #[test]
 fn schlick_is_close_to_exact_for_glass() {
-    // Schlick's error for n = 1.5 stays under a few percent of reflectance everywhere.
+    // Schlick's error for n = 1.5 peaks near 0.04 around 83°; anything larger is a bug in it.
     for k in 0..90 {
         let c = (k as f32).to_radians().cos();
         let (e, s) = (fresnel_dielectric(c, 1.5), fresnel_schlick(c, 1.5));
-        assert!((e - s).abs() < 0.03, "{k}°: exact {e} schlick {s}");
+        assert!((e - s).abs() < 0.05, "{k}°: exact {e} schlick {s}");
     }
 }
 

@@ -12,7 +12,11 @@ use std::fmt;
 use std::path::{Path, PathBuf};
 
 #[derive(Parser, Debug)]
-#[command(name = "prism", version, about = "A physically based spectral path tracer for RON scenes")]
+#[command(
+    name = "prism",
+    version,
+    about = "A physically based spectral path tracer for RON scenes"
+)]
 pub struct Cli {
     #[command(subcommand)]
     pub command: Command,
@@ -116,7 +120,9 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
         if (1..=65536).contains(&n) {
             Ok(n)
         } else {
-            Err(format!("width and height must be in 1..=65536 pixels, got '{s}'"))
+            Err(format!(
+                "width and height must be in 1..=65536 pixels, got '{s}'"
+            ))
         }
     };
     Ok((p(w)?, p(h)?))
@@ -145,7 +151,11 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
 }
 
 /// Loads a scene with the command line's overrides folded into `--set` form.
-fn load_scene(path: &Path, set: &[(String, String)], extra: &[(String, String)]) -> Result<LoadedScene, CliError> {
+fn load_scene(
+    path: &Path,
+    set: &[(String, String)],
+    extra: &[(String, String)],
+) -> Result<LoadedScene, CliError> {
     let mut all = set.to_vec();
     all.extend_from_slice(extra);
     Ok(scene_file::load(path, &all)?)
@@ -184,7 +194,9 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
     if let Some(t) = a.time_limit
         && !(t.is_finite() && t > 0.0)
     {
-        return Err(CliError(format!("--time-limit must be a positive number of seconds, got {t}")));
+        return Err(CliError(format!(
+            "--time-limit must be a positive number of seconds, got {t}"
+        )));
     }
     if a.threads == Some(0) {
         return Err(CliError("--threads must be at least 1".into()));
@@ -193,7 +205,9 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
     let output = a.output.clone().unwrap_or_else(|| {
         PathBuf::from(format!(
             "{}.png",
-            a.scene.file_stem().map_or("render".into(), |s| s.to_string_lossy())
+            a.scene
+                .file_stem()
+                .map_or("render".into(), |s| s.to_string_lossy())
         ))
     });
     // Fail on a bad output name before spending time on the render.
@@ -223,14 +237,32 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
         sample_offset: a.sample_offset as u64,
         scene_hash: scene.hash,
     };
-    film::write_image(&output, &out.image(), &meta, &PngOptions { exposure: a.exposure })?;
+    film::write_image(
+        &output,
+        &out.image(),
+        &meta,
+        &PngOptions {
+            exposure: a.exposure,
+        },
+    )?;
     if a.stats {
         let threads = pool.current_num_threads();
         let s = &out.stats;
         let sps = s.samples as f64 / out.seconds.max(1e-9);
-        eprintln!("image: {} ({}x{}, {} spp)", output.display(), out.width, out.height, out.spp);
+        eprintln!(
+            "image: {} ({}x{}, {} spp)",
+            output.display(),
+            out.width,
+            out.height,
+            out.spp
+        );
         eprintln!("time: {:.3} s on {} threads", out.seconds, threads);
-        eprintln!("samples: {} ({:.0} samples/s, {:.0} samples/s per thread)", s.samples, sps, sps / threads as f64);
+        eprintln!(
+            "samples: {} ({:.0} samples/s, {:.0} samples/s per thread)",
+            s.samples,
+            sps,
+            sps / threads as f64
+        );
         eprintln!("dropped samples: {}", s.dropped);
         eprintln!(
             "rays: {} closest-hit, {} shadow ({:.2} Mrays/s)",
@@ -241,10 +273,19 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
         let k = rs.accel.stats();
         eprintln!(
             "kd-tree: {} primitives, {} nodes, depth {}, {:.2} primitives per leaf, built in {:.3} ms",
-            k.primitives, k.nodes, k.max_depth, k.mean_leaf_prims, rs.accel_seconds * 1e3
+            k.primitives,
+            k.nodes,
+            k.max_depth,
+            k.mean_leaf_prims,
+            rs.accel_seconds * 1e3
         );
     } else if !a.quiet {
-        eprintln!("wrote {} ({} spp, {:.2} s)", output.display(), out.spp, out.seconds);
+        eprintln!(
+            "wrote {} ({} spp, {:.2} s)",
+            output.display(),
+            out.spp,
+            out.seconds
+        );
     }
     Ok(())
 }
@@ -256,12 +297,23 @@ fn info(a: InfoArgs) -> Result<(), CliError> {
     println!("scene: {}", a.scene.display());
     println!(
         "render: {}x{}, {} spp, max depth {}, seed {}, {:?} light sampling, rr depth {}, {:?} Fresnel, {:?} sampler",
-        s.width, s.height, s.spp, s.max_depth, s.seed, s.light_sampling, s.rr_depth, s.fresnel, s.sampler
+        s.width,
+        s.height,
+        s.spp,
+        s.max_depth,
+        s.seed,
+        s.light_sampling,
+        s.rr_depth,
+        s.fresnel,
+        s.sampler
     );
     println!("entities: {}", rs.prims.len());
     for i in 0..rs.prims.len() {
         let m = rs.prims.materials[rs.prims.material[i] as usize];
-        println!("  \"{}\": {:?}, {:?}", rs.prims.names[i], rs.prims.kind[i], m);
+        println!(
+            "  \"{}\": {:?}, {:?}",
+            rs.prims.names[i], rs.prims.kind[i], m
+        );
     }
     println!("effects:");
     for line in rs.effects.to_string().lines() {
@@ -279,7 +331,11 @@ fn info(a: InfoArgs) -> Result<(), CliError> {
         "lights: {} ({} area{})",
         rs.lights.lights.len(),
         rs.lights.lights.len() - rs.lights.environment.is_some() as usize,
-        if rs.lights.environment.is_some() { ", environment" } else { "" }
+        if rs.lights.environment.is_some() {
+            ", environment"
+        } else {
+            ""
+        }
     );
     let k = rs.accel.stats();
     println!(

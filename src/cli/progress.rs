@@ -21,10 +21,8 @@ impl Progress {
         let bar = (!quiet && tty).then(|| {
             let b = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
             b.set_style(
-                ProgressStyle::with_template(
-                    "{bar:40.cyan/blue} {percent:>3}% {msg} eta {eta}",
-                )
-                .expect("static template"),
+                ProgressStyle::with_template("{bar:40.cyan/blue} {percent:>3}% {msg} eta {eta}")
+                    .expect("static template"),
             );
             b.enable_steady_tick(Duration::from_millis(200));
             b

@@ -17,10 +17,24 @@ use glam::Vec3;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Shape {
-    Sphere { center: Vec3, radius: f32 },
-    Rect { center: Vec3, u: Vec3, v: Vec3 },
-    Disk { center: Vec3, normal: Vec3, radius: f32 },
-    Box { min: Vec3, max: Vec3 },
+    Sphere {
+        center: Vec3,
+        radius: f32,
+    },
+    Rect {
+        center: Vec3,
+        u: Vec3,
+        v: Vec3,
+    },
+    Disk {
+        center: Vec3,
+        normal: Vec3,
+        radius: f32,
+    },
+    Box {
+        min: Vec3,
+        max: Vec3,
+    },
 }
 
 impl Shape {

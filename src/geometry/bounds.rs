@@ -26,9 +26,7 @@ impl Aabb {
 
     #[inline]
     pub fn from_points(points: &[Vec3]) -> Self {
-        points
-            .iter()
-            .fold(Self::EMPTY, |b, &p| b.union_point(p))
+        points.iter().fold(Self::EMPTY, |b, &p| b.union_point(p))
     }
 
     #[inline]

@@ -12,6 +12,18 @@ pub struct SurfacePoint {
     pub p: Vec3,
     /// Unit geometric normal: outward for closed shapes, `normalize(u × v)` for planar ones.
     pub n: Vec3,
+    /// Whether the ray arrived from the side `n` points to. Decided from the intersection's
+    /// topology (origin outside a closed shape, sign of the plane crossing), not from the sign
+    /// of a dot product that rounding can flip at grazing angles.
+    pub front: bool,
+}
+
+impl SurfacePoint {
+    /// The normal on the side the ray came from.
+    #[inline]
+    pub fn facing(&self) -> Vec3 {
+        if self.front { self.n } else { -self.n }
+    }
 }
 
 /// A point sampled on an emitter, as seen from a reference point.
@@ -55,8 +67,9 @@ impl Sphere {
     /// Nearest `t` in (0, t_max). The discriminant is formed from the distance between the
     /// centre and the ray's closest point (Haines et al., Ray Tracing Gems ch. 7), which stays
     /// accurate for distant and tangent rays, and the roots use the stable quadratic form.
+    /// Also says whether the ray starts outside (so meets the outer side).
     #[inline]
-    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<f32> {
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<(f32, bool)> {
         let f = ray.o - self.center;
         let a = ray.d.length_squared();
         let b = f.dot(ray.d);
@@ -71,22 +84,24 @@ impl Sphere {
         if t0 > t1 {
             std::mem::swap(&mut t0, &mut t1);
         }
+        let outside = c > 0.0;
         if t0 > 0.0 && t0 < t_max {
-            Some(t0)
+            Some((t0, outside))
         } else if t1 > 0.0 && t1 < t_max {
-            Some(t1)
+            Some((t1, outside))
         } else {
             None
         }
     }
 
     #[inline]
-    pub fn surface(&self, ray: &Ray, t: f32) -> SurfacePoint {
+    pub fn surface(&self, ray: &Ray, t: f32, front: bool) -> SurfacePoint {
         let rel = ray.at(t) - self.center;
         let n = rel.normalize_or(Vec3::Y);
         SurfacePoint {
             p: self.center + n * self.radius,
             n,
+            front,
         }
     }
 
@@ -204,10 +219,11 @@ impl Planar {
     }
 
     #[inline]
-    pub fn surface(&self, a: f32, b: f32) -> SurfacePoint {
+    pub fn surface(&self, ray: &Ray, a: f32, b: f32) -> SurfacePoint {
         SurfacePoint {
             p: self.center + a * self.u + b * self.v,
             n: self.n,
+            front: ray.d.dot(self.n) < 0.0,
         }
     }
 
@@ -281,8 +297,9 @@ impl OrientedBox {
         )
     }
 
+    /// Also says whether the ray starts outside the box.
     #[inline]
-    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<f32> {
+    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<(f32, bool)> {
         let r = self.object_ray(ray);
         let inv = r.d.recip();
         let t0 = (self.min - r.o) * inv;
@@ -296,15 +313,15 @@ impl OrientedBox {
             return None;
         }
         if t_near > 0.0 && t_near < t_max {
-            Some(t_near)
+            Some((t_near, true))
         } else if t_near <= 0.0 && t_far > 0.0 && t_far < t_max {
-            Some(t_far)
+            Some((t_far, false))
         } else {
             None
         }
     }
 
-    pub fn surface(&self, ray: &Ray, t: f32) -> SurfacePoint {
+    pub fn surface(&self, ray: &Ray, t: f32, front: bool) -> SurfacePoint {
         let r = self.object_ray(ray);
         let mut p = r.at(t);
         // The face is the one the point lies closest to, relative to the box size; snapping
@@ -329,6 +346,7 @@ impl OrientedBox {
         SurfacePoint {
             p: self.to_world.transform_point3(p),
             n: (self.normal_matrix * n_obj).normalize(),
+            front,
         }
     }
 }

@@ -149,7 +149,11 @@ impl RenderOutput {
 
 /// Renders the scene on the current rayon pool. `progress` is told the number of samples
 /// finished, once per tile.
-pub fn render(scene: &RenderScene, opts: &RenderOptions, progress: &(dyn Fn(u64) + Sync)) -> RenderOutput {
+pub fn render(
+    scene: &RenderScene,
+    opts: &RenderOptions,
+    progress: &(dyn Fn(u64) + Sync),
+) -> RenderOutput {
     let fx = &scene.effects;
     let (s, m, mo) = (
         fx.has(Effect::Spectral),
@@ -183,7 +187,11 @@ fn render_with<const SPECTRAL: bool, const MEDIA: bool, const MOTION: bool>(
     let mut done = 0u32;
     // Without a time limit one pass renders everything; with one, passes double in size
     // so the limit is checked often early on and rarely later.
-    let mut pass = if opts.time_limit.is_some() { 1 } else { opts.spp.max(1) };
+    let mut pass = if opts.time_limit.is_some() {
+        1
+    } else {
+        opts.spp.max(1)
+    };
     while done < opts.spp {
         let n = pass.min(opts.spp - done);
         let s0 = opts.sample_offset + done;
@@ -194,9 +202,15 @@ fn render_with<const SPECTRAL: bool, const MEDIA: bool, const MOTION: bool>(
                 let mut film = vec![[0.0f64; 3]; tile.pixels()];
                 let mut st = RenderStats::default();
                 match opts.integrator {
-                    Integrator::Wavefront => {
-                        wavefront::render_tile::<MOTION>(&ctx, q, tile, s0, s0 + n, &mut film, &mut st)
-                    }
+                    Integrator::Wavefront => wavefront::render_tile::<MOTION>(
+                        &ctx,
+                        q,
+                        tile,
+                        s0,
+                        s0 + n,
+                        &mut film,
+                        &mut st,
+                    ),
                     Integrator::Reference => {
                         reference::render_tile::<MOTION>(&ctx, tile, s0, s0 + n, &mut film, &mut st)
                     }
@@ -206,11 +220,11 @@ fn render_with<const SPECTRAL: bool, const MEDIA: bool, const MOTION: bool>(
             })
             .collect();
         for (tile, (film, st)) in tiles.iter().zip(&results) {
-            for p in 0..tile.pixels() {
+            for (p, src) in film.iter().enumerate() {
                 let (x, y) = tile.pixel(p);
                 let dst = &mut sums[(y * w + x) as usize];
                 for c in 0..3 {
-                    dst[c] += film[p][c];
+                    dst[c] += src[c];
                 }
             }
             stats.add(st);

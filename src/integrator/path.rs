@@ -156,6 +156,30 @@ pub fn lens_point(u: Vec2, blades: u32) -> Vec2 {
     p0 * b.x + p1 * b.y
 }
 
+/// Mirror reflection kept on the side of `n`: at grazing angles rounding can leave `wo` a
+/// hair below the surface, and the reflected ray must still leave on the side it is spawned.
+#[inline]
+fn reflect_above(wo: Vec3, n: Vec3) -> Vec3 {
+    let r = reflect(wo, n);
+    let c = r.dot(n);
+    if c >= 0.0 {
+        r
+    } else {
+        (r - 2.0 * c * n).normalize()
+    }
+}
+
+/// A transmitted direction kept strictly below the surface `n` faces.
+#[inline]
+fn below(wt: Vec3, n: Vec3) -> Vec3 {
+    let c = wt.dot(n);
+    if c <= 0.0 {
+        wt
+    } else {
+        (wt - 2.0 * c * n).normalize()
+    }
+}
+
 /// Processes the vertex where `s.ray` ends: adds emission found there (MIS-weighted), then
 /// either ends the path or scatters it, returning a shadow ray for next-event estimation.
 #[inline]
@@ -203,7 +227,7 @@ pub fn shade(ctx: &Ctx, s: &mut PathState, hit: Option<Hit>) -> Option<ShadowReq
     let (pixel, index) = (s.pixel, s.sample);
     s.depth += 1;
     // Surfaces scatter on both sides: work in the frame facing the incoming ray.
-    let nf = if sp.n.dot(wo) < 0.0 { -sp.n } else { sp.n };
+    let nf = sp.facing();
     let mut shadow = None;
     match material {
         Material::Diffuse { albedo } => {
@@ -220,7 +244,9 @@ pub fn shade(ctx: &Ctx, s: &mut PathState, hit: Option<Hit>) -> Option<ShadowReq
                         if contrib != Vec3::ZERO {
                             let (ray, t_max) = match ls.point {
                                 Some((q, nq)) => spawn_ray_to(sp.p, nf, q, nq),
-                                None => (Ray::new(offset_ray_origin(sp.p, nf), ls.wi), f32::INFINITY),
+                                None => {
+                                    (Ray::new(offset_ray_origin(sp.p, nf), ls.wi), f32::INFINITY)
+                                }
                             };
                             shadow = Some(ShadowRequest {
                                 ray,
@@ -243,13 +269,12 @@ pub fn shade(ctx: &Ctx, s: &mut PathState, hit: Option<Hit>) -> Option<ShadowReq
         Material::Mirror { tint } => {
             s.beta *= tint;
             s.specular = true;
-            s.ray = Ray::new(offset_ray_origin(sp.p, nf), reflect(wo, nf));
+            s.ray = Ray::new(offset_ray_origin(sp.p, nf), reflect_above(wo, nf));
         }
         Material::Dielectric { ior } => {
-            // The geometric normal points out of a closed shape: entering when wo is on
-            // its side.
-            let eta = if sp.n.dot(wo) > 0.0 { ior } else { 1.0 / ior };
-            let cos_i = wo.dot(nf);
+            // The geometric normal points out of a closed shape: entering on its front.
+            let eta = if sp.front { ior } else { 1.0 / ior };
+            let cos_i = wo.dot(nf).max(0.0);
             let r = if ctx.schlick {
                 fresnel_schlick(cos_i, eta)
             } else {
@@ -262,10 +287,10 @@ pub fn shade(ctx: &Ctx, s: &mut PathState, hit: Option<Hit>) -> Option<ShadowReq
                     // Radiance is compressed by 1/η² crossing into a denser medium.
                     s.beta /= eta * eta;
                     s.eta_scale *= eta * eta;
-                    s.ray = Ray::new(offset_ray_origin(sp.p, -nf), wt);
+                    s.ray = Ray::new(offset_ray_origin(sp.p, -nf), below(wt, nf));
                 }
                 _ => {
-                    s.ray = Ray::new(offset_ray_origin(sp.p, nf), reflect(wo, nf));
+                    s.ray = Ray::new(offset_ray_origin(sp.p, nf), reflect_above(wo, nf));
                 }
             }
         }

@@ -64,21 +64,25 @@ pub fn load_str(
 /// Deserialises the schema, turning RON's error position into file:line:col with the entity
 /// and field it falls in.
 pub fn parse(text: &str, path: &Path) -> Result<schema::Scene, SceneError> {
-    ron::Options::default()
-        .from_str::<schema::Scene>(text)
-        .map_err(|e| {
-            let pos = e.span.start;
-            let at = offset_of(text, pos.line, pos.col);
-            let (entity, field) = context_at(text, at);
-            SceneError::Parse {
-                path: path.to_path_buf(),
-                line: pos.line,
-                col: pos.col,
-                entity,
-                field,
-                message: e.code.to_string(),
-            }
-        })
+    ron_options().from_str::<schema::Scene>(text).map_err(|e| {
+        let pos = e.span.start;
+        let at = offset_of(text, pos.line, pos.col);
+        let (entity, field) = context_at(text, at);
+        SceneError::Parse {
+            path: path.to_path_buf(),
+            line: pos.line,
+            col: pos.col,
+            entity,
+            field,
+            message: e.code.to_string(),
+        }
+    })
+}
+
+/// RON options for scene files: optional fields may be written bare (`lens: (..)`) or as
+/// `Some(..)`, whether or not the file enables `implicit_some` itself.
+pub fn ron_options() -> ron::Options {
+    ron::Options::default().with_default_extension(ron::extensions::Extensions::IMPLICIT_SOME)
 }
 
 const FNV_OFFSET: u64 = 0xcbf2_9ce4_8422_2325;
@@ -115,16 +119,14 @@ pub const OVERRIDE_KEYS: &[&str] = &[
 
 /// Applies one `--set KEY=VALUE`; VALUE is RON for the field's type (`Schlick`, `64`,
 /// `(0.0, 1.0, 5.0)`), checked like the field in the file.
-pub fn apply_override(
-    scene: &mut schema::Scene,
-    key: &str,
-    value: &str,
-) -> Result<(), SceneError> {
+pub fn apply_override(scene: &mut schema::Scene, key: &str, value: &str) -> Result<(), SceneError> {
     fn val<T: serde::de::DeserializeOwned>(key: &str, value: &str) -> Result<T, SceneError> {
-        ron::from_str(value).map_err(|e| SceneError::Override {
-            key: key.to_string(),
-            message: format!("cannot use '{value}': {}", e.code),
-        })
+        ron_options()
+            .from_str(value)
+            .map_err(|e| SceneError::Override {
+                key: key.to_string(),
+                message: format!("cannot use '{value}': {}", e.code),
+            })
     }
     let r = &mut scene.render;
     let c = &mut scene.camera;
@@ -187,7 +189,9 @@ fn build_world(scene: schema::Scene, path: &Path, hash: u64) -> Result<LoadedSce
     let cam = &scene.camera;
     let (pos, at, up) = (cam.position.vec(), cam.look_at.vec(), cam.up.vec());
     let fwd = at - pos;
-    if fwd.length_squared() == 0.0 || fwd.cross(up).length_squared() <= 1e-12 * fwd.length_squared() * up.length_squared() {
+    if fwd.length_squared() == 0.0
+        || fwd.cross(up).length_squared() <= 1e-12 * fwd.length_squared() * up.length_squared()
+    {
         return Err(SceneError::Entity {
             path: path.to_path_buf(),
             entity: "camera".into(),
@@ -203,7 +207,10 @@ fn build_world(scene: schema::Scene, path: &Path, hash: u64) -> Result<LoadedSce
         aperture_radius: cam.lens.as_ref().map_or(0.0, |l| l.aperture_radius.0),
         focus_distance: cam.lens.as_ref().map_or(1.0, |l| l.focus_distance.0),
         blades: cam.lens.as_ref().map_or(0, |l| l.blades.0),
-        shutter: cam.shutter.as_ref().map_or((0.0, 1.0), |s| (s.open, s.close)),
+        shutter: cam
+            .shutter
+            .as_ref()
+            .map_or((0.0, 1.0), |s| (s.open, s.close)),
     };
     let r = &scene.render;
     let render = RenderSettings {

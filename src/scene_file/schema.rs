@@ -175,7 +175,12 @@ struct ShutterSpec {
 impl TryFrom<ShutterSpec> for Shutter {
     type Error = String;
     fn try_from(s: ShutterSpec) -> Result<Self, String> {
-        if !(s.open.is_finite() && s.close.is_finite() && 0.0 <= s.open && s.open <= s.close && s.close <= 1.0) {
+        if !(s.open.is_finite()
+            && s.close.is_finite()
+            && 0.0 <= s.open
+            && s.open <= s.close
+            && s.close <= 1.0)
+        {
             return Err(format!(
                 "shutter must satisfy 0 <= open <= close <= 1 (a fraction of a frame), got open {} close {}",
                 s.open, s.close
@@ -219,13 +224,28 @@ pub struct Entity {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(try_from = "ShapeSpec")]
 pub enum Shape {
-    Sphere { center: V3, radius: Positive },
-    Rect { center: V3, u: V3, v: V3 },
-    Disk { center: V3, normal: V3, radius: Positive },
-    Box { min: V3, max: V3 },
+    Sphere {
+        center: V3,
+        radius: Positive,
+    },
+    Rect {
+        center: V3,
+        u: V3,
+        v: V3,
+    },
+    Disk {
+        center: V3,
+        normal: V3,
+        radius: Positive,
+    },
+    Box {
+        min: V3,
+        max: V3,
+    },
 }
 
 #[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
 enum ShapeSpec {
     Sphere {
         center: V3,
@@ -295,7 +315,9 @@ impl TryFrom<ShapeSpec> for Shape {
                 Shape::Box { min, max }
             }
             ShapeSpec::Mesh { .. } => {
-                return Err("Mesh shapes are not supported by this build yet (triangle meshes)".into());
+                return Err(
+                    "Mesh shapes are not supported by this build yet (triangle meshes)".into(),
+                );
             }
             ShapeSpec::Revolution { .. } => {
                 return Err(
@@ -319,10 +341,17 @@ pub struct Transform {
 }
 
 #[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Material {
-    Diffuse { albedo: Albedo },
-    Mirror { tint: Albedo },
-    Dielectric { ior: Ior },
+    Diffuse {
+        albedo: Albedo,
+    },
+    Mirror {
+        tint: Albedo,
+    },
+    Dielectric {
+        ior: Ior,
+    },
     Light {
         emission: Emission,
         #[serde(default)]
@@ -336,6 +365,7 @@ pub enum Material {
 pub struct Ior(pub f32);
 
 #[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
 enum IorSpec {
     Constant(f32),
     Cauchy {
@@ -407,6 +437,7 @@ impl TryFrom<Color> for Albedo {
 pub struct Emission(pub Color);
 
 #[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
 enum EmissionSpec {
     Rgb(f32, f32, f32),
     Blackbody {
@@ -436,9 +467,11 @@ impl TryFrom<EmissionSpec> for Emission {
                     ))
                 }
             }
-            _ => Err("spectral emitters (Blackbody, Illuminant) need spectral transport, \
+            _ => Err(
+                "spectral emitters (Blackbody, Illuminant) need spectral transport, \
                       which this build does not have yet; use Rgb(r, g, b)"
-                .into()),
+                    .into(),
+            ),
         }
     }
 }
@@ -503,16 +536,11 @@ checked_number!(
     Spp(u32, "u32"), |x: u32| x >= 1, "at least 1 sample per pixel");
 checked_number!(
     /// Number of aperture blades: 0 for a round aperture, otherwise at least 3.
+    #[derive(Default)]
     Blades(u32, "u32"), |x: u32| x == 0 || (3..=64).contains(&x), "0 (round) or 3..=64");
 checked_number!(
     /// Wavelengths carried per path in spectral mode.
     Wavelengths(u32, "u32"), |x: u32| (1..=4).contains(&x), "1..=4");
-
-impl Default for Blades {
-    fn default() -> Self {
-        Blades(0)
-    }
-}
 
 /// `scale: 2.0` or `scale: (1.0, 2.0, 1.0)`; every component non-zero and finite.
 #[derive(Clone, Copy, Debug, PartialEq)]

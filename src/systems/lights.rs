@@ -40,7 +40,13 @@ impl Lights {
 
     /// Chooses a light by power and samples a direction to it from `p`.
     #[inline]
-    pub fn sample(&self, prims: &Primitives, p: Vec3, u_select: f32, u: Vec2) -> Option<LightSample> {
+    pub fn sample(
+        &self,
+        prims: &Primitives,
+        p: Vec3,
+        u_select: f32,
+        u: Vec2,
+    ) -> Option<LightSample> {
         if self.lights.is_empty() {
             return None;
         }

@@ -68,10 +68,15 @@ impl Primitives {
     pub fn intersect(&self, i: u32, ray: &Ray, t_max: f32) -> Option<(f32, f32, f32)> {
         let l = self.local[i as usize] as usize;
         match self.kind[i as usize] {
-            PrimKind::Sphere => self.spheres[l].intersect(ray, t_max).map(|t| (t, 0.0, 0.0)),
+            // Closed shapes keep "started outside" in u for the surface stage.
+            PrimKind::Sphere => self.spheres[l]
+                .intersect(ray, t_max)
+                .map(|(t, out)| (t, out as u32 as f32, 0.0)),
             PrimKind::Rect => self.planars[l].intersect(ray, t_max, false),
             PrimKind::Disk => self.planars[l].intersect(ray, t_max, true),
-            PrimKind::Box => self.boxes[l].intersect(ray, t_max).map(|t| (t, 0.0, 0.0)),
+            PrimKind::Box => self.boxes[l]
+                .intersect(ray, t_max)
+                .map(|(t, out)| (t, out as u32 as f32, 0.0)),
         }
     }
 
@@ -80,9 +85,9 @@ impl Primitives {
     pub fn surface(&self, ray: &Ray, hit: &Hit) -> SurfacePoint {
         let l = self.local[hit.prim as usize] as usize;
         match self.kind[hit.prim as usize] {
-            PrimKind::Sphere => self.spheres[l].surface(ray, hit.t),
-            PrimKind::Rect | PrimKind::Disk => self.planars[l].surface(hit.u, hit.v),
-            PrimKind::Box => self.boxes[l].surface(ray, hit.t),
+            PrimKind::Sphere => self.spheres[l].surface(ray, hit.t, hit.u > 0.5),
+            PrimKind::Rect | PrimKind::Disk => self.planars[l].surface(ray, hit.u, hit.v),
+            PrimKind::Box => self.boxes[l].surface(ray, hit.t, hit.u > 0.5),
         }
     }
 
