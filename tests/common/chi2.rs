@@ -417,9 +417,21 @@ fn integrate_bins(
         for i in 0..rx {
             let x0 = lo[0] + wx * i as f64;
             let y0 = lo[1] + wy * j as f64;
-            let cell = [x0, y0, x0 + wx, y0 + wy];
-            let whole = simpson_cell(cell, density);
-            bins.push(adaptive_cell(cell, whole, max_depth, density));
+            // Each bin starts as 4 × 4 sub-cells: a pdf that is zero at every node of one
+            // Simpson cell (a thin corner of an emitter crossing the bin) would otherwise
+            // look empty to the adaptive refinement.
+            const SPLIT: usize = 4;
+            let (sx, sy) = (wx / SPLIT as f64, wy / SPLIT as f64);
+            let mut sum = 0.0;
+            for b in 0..SPLIT {
+                for a in 0..SPLIT {
+                    let (cx, cy) = (x0 + sx * a as f64, y0 + sy * b as f64);
+                    let cell = [cx, cy, cx + sx, cy + sy];
+                    let whole = simpson_cell(cell, density);
+                    sum += adaptive_cell(cell, whole, max_depth, density);
+                }
+            }
+            bins.push(sum);
         }
     }
     bins
