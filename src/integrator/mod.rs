@@ -102,6 +102,12 @@ pub(crate) fn accumulate(
     px[2] += l.z as f64;
 }
 
+thread_local! {
+    // Each worker thread allocates its queues once and reuses them for every tile, pass and
+    // render (rayon's `map_init` would build them again for every split of the work).
+    static QUEUES: std::cell::RefCell<wavefront::Queues> = std::cell::RefCell::new(wavefront::Queues::default());
+}
+
 /// Which integrator runs the passes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Integrator {
@@ -198,19 +204,21 @@ fn render_with<const SPECTRAL: bool, const MEDIA: bool, const MOTION: bool>(
         let t_pass = Instant::now();
         let results: Vec<(Vec<[f64; 3]>, RenderStats)> = tiles
             .par_iter()
-            .map_init(wavefront::Queues::default, |q, tile| {
+            .map(|tile| {
                 let mut film = vec![[0.0f64; 3]; tile.pixels()];
                 let mut st = RenderStats::default();
                 match opts.integrator {
-                    Integrator::Wavefront => wavefront::render_tile::<MOTION>(
-                        &ctx,
-                        q,
-                        tile,
-                        s0,
-                        s0 + n,
-                        &mut film,
-                        &mut st,
-                    ),
+                    Integrator::Wavefront => QUEUES.with_borrow_mut(|q| {
+                        wavefront::render_tile::<MOTION>(
+                            &ctx,
+                            q,
+                            tile,
+                            s0,
+                            s0 + n,
+                            &mut film,
+                            &mut st,
+                        )
+                    }),
                     Integrator::Reference => {
                         reference::render_tile::<MOTION>(&ctx, tile, s0, s0 + n, &mut film, &mut st)
                     }

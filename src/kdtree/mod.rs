@@ -55,7 +55,7 @@ impl Default for KdParams {
         Self {
             traversal_cost: 1.0,
             // A ray–primitive test costs about 1.5 node steps.
-            intersect_cost: 1.5,
+            intersect_cost: 20.0,
             empty_bonus: 0.5,
             max_leaf_prims: 1,
             max_depth: None,
