@@ -51,7 +51,7 @@ pub struct RenderArgs {
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
     /// Stop between whole passes after this many seconds; every pixel keeps the same count.
-    #[arg(long)]
+    #[arg(long, allow_negative_numbers = true)]
     pub time_limit: Option<f64>,
     /// Override a scene value by path, e.g. render.integrator.fresnel=Schlick.
     #[arg(long = "set", value_parser = parse_key_value)]
