@@ -52,14 +52,29 @@ fn kdtree(c: &mut Criterion) {
     g.bench_function("closest_hit_cornell_4096", |b| {
         b.iter(|| {
             rays.iter()
-                .filter(|r| scene.intersect(r, f32::INFINITY).is_some())
+                .filter(|r| scene.intersect::<false>(r, f32::INFINITY, 0.0).is_some())
                 .count()
         })
     });
     g.bench_function("any_hit_cornell_4096", |b| {
-        b.iter(|| rays.iter().filter(|r| scene.occluded(r, 300.0)).count())
+        b.iter(|| {
+            rays.iter()
+                .filter(|r| scene.occluded::<false>(r, 300.0, 0.0))
+                .count()
+        })
     });
     g.finish();
+}
+
+fn camera_rays<const MOTION: bool>(ctx: &Ctx) -> Vec2 {
+    let mut acc = Vec2::ZERO;
+    for y in 0..64 {
+        for x in 0..64 {
+            let s = camera_ray::<MOTION>(ctx, x, y, 0);
+            acc += s.ray.d.truncate() + s.time;
+        }
+    }
+    acc
 }
 
 fn camera(c: &mut Criterion) {
@@ -68,18 +83,26 @@ fn camera(c: &mut Criterion) {
     for (name, lens) in [("pinhole", false), ("lens", true)] {
         let ctx = Ctx::new(&scene, lens);
         g.bench_function(format!("rays_64x64_{name}"), |b| {
-            b.iter(|| {
-                let mut acc = Vec2::ZERO;
-                for y in 0..64 {
-                    for x in 0..64 {
-                        let s = camera_ray::<false>(&ctx, x, y, 0);
-                        acc += s.ray.d.truncate();
-                    }
-                }
-                acc
-            })
+            b.iter(|| camera_rays::<false>(&ctx))
+        });
+        g.bench_function(format!("rays_64x64_{name}_motion"), |b| {
+            b.iter(|| camera_rays::<true>(&ctx))
         });
     }
+    // A camera moving within the shutter evaluates its path for every ray.
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/flyby.ron");
+    let o = vec![
+        ("render.width".to_string(), "64".to_string()),
+        ("render.height".to_string(), "64".to_string()),
+    ];
+    let flyby = prepare(
+        &prism::scene_file::load(&path, &o).unwrap(),
+        &KdParams::default(),
+    );
+    let ctx = Ctx::new(&flyby, false);
+    g.bench_function("rays_64x64_moving_camera", |b| {
+        b.iter(|| camera_rays::<true>(&ctx))
+    });
     g.finish();
 }
 
@@ -98,6 +121,37 @@ fn integrator(c: &mut Criterion) {
             integrator,
         };
         g.bench_function(format!("cornell_64x64_4spp_{name}"), |b| {
+            b.iter(|| render(&scene, &opts, &|_| {}).stats.samples)
+        });
+    }
+    // The motion-blur scene against the same scene with its motion removed.
+    let text = std::fs::read_to_string(
+        Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/motion_blur.ron"),
+    )
+    .unwrap();
+    let still = text
+        .replace("motion: (velocity: (1.6, 0.3, 0.0))", "")
+        .replace("motion: (angular_velocity: (0.0, 60.0, 0.0))", "");
+    assert_ne!(
+        text, still,
+        "motion_blur.ron still has the motions this bench removes"
+    );
+    for (name, t) in [("motion_blur", &text), ("motion_blur_static", &still)] {
+        let o = vec![
+            ("render.width".to_string(), "64".to_string()),
+            ("render.height".to_string(), "36".to_string()),
+            ("render.spp".to_string(), "4".to_string()),
+        ];
+        let loaded =
+            prism::scene_file::load_str(t, Path::new("scenes/motion_blur.ron"), &o).unwrap();
+        let scene = prepare(&loaded, &KdParams::default());
+        let opts = RenderOptions {
+            sample_offset: 0,
+            spp: 4,
+            time_limit: None,
+            integrator: Integrator::Wavefront,
+        };
+        g.bench_function(format!("{name}_64x36_4spp"), |b| {
             b.iter(|| render(&scene, &opts, &|_| {}).stats.samples)
         });
     }

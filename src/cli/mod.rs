@@ -1,5 +1,6 @@
 //! The `prism` command line: render, info, compare.
 
+pub mod frames;
 mod progress;
 
 use crate::film::{self, ImageMeta, PngOptions};
@@ -65,6 +66,16 @@ pub struct RenderArgs {
     /// PNG exposure in stops.
     #[arg(long, default_value_t = 0.0)]
     pub exposure: f32,
+    /// Render a frame range (Rust syntax: 0..24 or 0..=23); `-o` names frames with a run of
+    /// '#', e.g. out/frame_####.png.
+    #[arg(long, value_parser = frames::parse_range)]
+    pub frames: Option<std::ops::Range<u32>>,
+    /// With --frames: skip frames whose image already exists.
+    #[arg(long, requires = "frames")]
+    pub resume: bool,
+    /// With --frames: also write the range as an animated GIF.
+    #[arg(long, requires = "frames")]
+    pub gif: Option<PathBuf>,
     /// Use the per-path reference integrator instead of the wavefront one.
     #[arg(long, hide = true)]
     pub reference: bool,
@@ -161,8 +172,13 @@ fn load_scene(
     Ok(scene_file::load(path, &all)?)
 }
 
-fn prepare(scene: &LoadedScene, force: &[String]) -> Result<RenderScene, CliError> {
-    let mut rs = systems::prepare(scene, &KdParams::default());
+fn prepare(scene: &LoadedScene, force: &[String], frame: u32) -> Result<RenderScene, CliError> {
+    let mut rs = systems::prepare_frame(scene, &KdParams::default(), frame);
+    force_effects(&mut rs, force)?;
+    Ok(rs)
+}
+
+fn force_effects(rs: &mut RenderScene, force: &[String]) -> Result<(), CliError> {
     for f in force {
         let e = Effect::parse(f).ok_or_else(|| {
             CliError(format!(
@@ -176,7 +192,7 @@ fn prepare(scene: &LoadedScene, force: &[String]) -> Result<RenderScene, CliErro
         })?;
         rs.effects.force(e).map_err(CliError)?;
     }
-    Ok(rs)
+    Ok(())
 }
 
 fn render(a: RenderArgs) -> Result<(), CliError> {
@@ -202,83 +218,33 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
         return Err(CliError("--threads must be at least 1".into()));
     }
     let scene = load_scene(&a.scene, &a.set, &extra)?;
-    let output = a.output.clone().unwrap_or_else(|| {
-        PathBuf::from(format!(
-            "{}.png",
-            a.scene
-                .file_stem()
-                .map_or("render".into(), |s| s.to_string_lossy())
-        ))
-    });
-    // Fail on a bad output name before spending time on the render.
-    film::ImageFormat::from_path(&output)?;
-    let rs = prepare(&scene, &a.force)?;
-    let spp = rs.settings.spp;
-    let opts = RenderOptions {
-        sample_offset: a.sample_offset,
-        spp,
-        time_limit: a.time_limit,
-        integrator: if a.reference {
-            Integrator::Reference
-        } else {
-            Integrator::Wavefront
-        },
-    };
+    let stem = a
+        .scene
+        .file_stem()
+        .map_or("render".to_string(), |s| s.to_string_lossy().to_string());
     let pool = rayon::ThreadPoolBuilder::new()
         .num_threads(a.threads.unwrap_or(0))
         .build()
         .map_err(|e| CliError(format!("cannot start worker threads: {e}")))?;
-    let total = rs.settings.width as u64 * rs.settings.height as u64 * spp as u64;
-    let bar = progress::Progress::new(total, a.quiet);
-    let out = pool.install(|| integrator::render(&rs, &opts, &|n| bar.add(n)));
-    bar.finish();
-    let meta = ImageMeta {
-        spp: out.spp,
-        sample_offset: a.sample_offset as u64,
-        scene_hash: scene.hash,
-    };
-    film::write_image(
-        &output,
-        &out.image(),
-        &meta,
-        &PngOptions {
-            exposure: a.exposure,
-        },
-    )?;
+    if let Some(range) = a.frames.clone() {
+        let template = a
+            .output
+            .clone()
+            .unwrap_or_else(|| PathBuf::from(format!("frames/{stem}_####.png")));
+        frames::check_template(&template)?;
+        film::ImageFormat::from_path(&template)?;
+        return render_frames(&a, &scene, &pool, range, &template);
+    }
+    let output = a
+        .output
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("{stem}.png")));
+    // Fail on a bad output name before spending time on the render.
+    film::ImageFormat::from_path(&output)?;
+    let rs = prepare(&scene, &a.force, 0)?;
+    let out = render_to_file(&a, &scene, &rs, &pool, &output, "")?;
     if a.stats {
-        let threads = pool.current_num_threads();
-        let s = &out.stats;
-        let sps = s.samples as f64 / out.seconds.max(1e-9);
-        eprintln!(
-            "image: {} ({}x{}, {} spp)",
-            output.display(),
-            out.width,
-            out.height,
-            out.spp
-        );
-        eprintln!("time: {:.3} s on {} threads", out.seconds, threads);
-        eprintln!(
-            "samples: {} ({:.0} samples/s, {:.0} samples/s per thread)",
-            s.samples,
-            sps,
-            sps / threads as f64
-        );
-        eprintln!("dropped samples: {}", s.dropped);
-        eprintln!(
-            "rays: {} closest-hit, {} shadow ({:.2} Mrays/s)",
-            s.rays,
-            s.shadow_rays,
-            (s.rays + s.shadow_rays) as f64 / out.seconds.max(1e-9) * 1e-6
-        );
-        let k = rs.accel.stats();
-        eprintln!(
-            "kd-tree: {} primitives, {} nodes, depth {}, {:.2} primitives per leaf, built in {:.3} ms",
-            k.primitives,
-            k.nodes,
-            k.max_depth,
-            k.mean_leaf_prims,
-            rs.accel_seconds * 1e3
-        );
+        print_stats(&rs, &out, &output, pool.current_num_threads());
     } else if !a.quiet {
         eprintln!(
             "wrote {} ({} spp, {:.2} s)",
@@ -290,9 +256,151 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
     Ok(())
 }
 
+/// Renders one frame of a prepared scene and writes it atomically.
+fn render_to_file(
+    a: &RenderArgs,
+    scene: &LoadedScene,
+    rs: &RenderScene,
+    pool: &rayon::ThreadPool,
+    output: &Path,
+    label: &str,
+) -> Result<integrator::RenderOutput, CliError> {
+    let spp = rs.settings.spp;
+    let opts = RenderOptions {
+        sample_offset: a.sample_offset,
+        spp,
+        time_limit: a.time_limit,
+        integrator: if a.reference {
+            Integrator::Reference
+        } else {
+            Integrator::Wavefront
+        },
+    };
+    let total = rs.settings.width as u64 * rs.settings.height as u64 * spp as u64;
+    let bar = progress::Progress::new(total, a.quiet, label);
+    let out = pool.install(|| integrator::render(rs, &opts, &|n| bar.add(n)));
+    bar.finish();
+    let meta = ImageMeta {
+        spp: out.spp,
+        sample_offset: a.sample_offset as u64,
+        scene_hash: scene.hash,
+    };
+    film::write_image(
+        output,
+        &out.image(),
+        &meta,
+        &PngOptions {
+            exposure: a.exposure,
+        },
+    )?;
+    Ok(out)
+}
+
+fn render_frames(
+    a: &RenderArgs,
+    scene: &LoadedScene,
+    pool: &rayon::ThreadPool,
+    range: std::ops::Range<u32>,
+    template: &Path,
+) -> Result<(), CliError> {
+    let n = range.len();
+    let mut rs: Option<RenderScene> = None;
+    let start = std::time::Instant::now();
+    let mut rendered = 0u32;
+    let mut written = Vec::with_capacity(n);
+    for (k, f) in range.clone().enumerate() {
+        let path = frames::frame_path(template, f);
+        written.push(path.clone());
+        if a.resume && path.is_file() {
+            if !a.quiet {
+                eprintln!(
+                    "frame {f} ({}/{n}): {} exists, skipped",
+                    k + 1,
+                    path.display()
+                );
+            }
+            continue;
+        }
+        // The scene is prepared once; later frames move the camera and rebuild the kd-tree
+        // only if primitives move.
+        let scene_for_frame = match rs.as_mut() {
+            None => rs.insert(prepare(scene, &a.force, f)?),
+            Some(r) => {
+                r.set_frame(scene, &KdParams::default(), f);
+                force_effects(r, &a.force)?;
+                r
+            }
+        };
+        scene_for_frame.settings.seed = frames::frame_seed(scene.render.seed, f);
+        let eta = if rendered > 0 {
+            let per = start.elapsed().as_secs_f64() / rendered as f64;
+            format!(", range eta {:.0}s", per * (n - k) as f64)
+        } else {
+            String::new()
+        };
+        let label = format!("frame {f} ({}/{n}{eta})", k + 1);
+        let out = render_to_file(a, scene, scene_for_frame, pool, &path, &label)?;
+        rendered += 1;
+        if a.stats {
+            print_stats(scene_for_frame, &out, &path, pool.current_num_threads());
+        } else if !a.quiet {
+            eprintln!(
+                "frame {f} ({}/{n}): wrote {} ({:.2} s, {:.2} Msamples/s)",
+                k + 1,
+                path.display(),
+                out.seconds,
+                out.stats.samples as f64 / out.seconds.max(1e-9) * 1e-6
+            );
+        }
+    }
+    if let Some(gif) = &a.gif {
+        let fps = scene.camera_path.as_ref().map_or(24, |p| p.fps);
+        frames::write_gif(&written, fps, gif)?;
+        if !a.quiet {
+            eprintln!("wrote {}", gif.display());
+        }
+    }
+    Ok(())
+}
+
+fn print_stats(rs: &RenderScene, out: &integrator::RenderOutput, output: &Path, threads: usize) {
+    let s = &out.stats;
+    let sps = s.samples as f64 / out.seconds.max(1e-9);
+    eprintln!(
+        "image: {} ({}x{}, {} spp)",
+        output.display(),
+        out.width,
+        out.height,
+        out.spp
+    );
+    eprintln!("time: {:.3} s on {} threads", out.seconds, threads);
+    eprintln!(
+        "samples: {} ({:.0} samples/s, {:.0} samples/s per thread)",
+        s.samples,
+        sps,
+        sps / threads as f64
+    );
+    eprintln!("dropped samples: {}", s.dropped);
+    eprintln!(
+        "rays: {} closest-hit, {} shadow ({:.2} Mrays/s)",
+        s.rays,
+        s.shadow_rays,
+        (s.rays + s.shadow_rays) as f64 / out.seconds.max(1e-9) * 1e-6
+    );
+    let k = rs.accel.stats();
+    eprintln!(
+        "kd-tree: {} primitives, {} nodes, depth {}, {:.2} primitives per leaf, built in {:.3} ms",
+        k.primitives,
+        k.nodes,
+        k.max_depth,
+        k.mean_leaf_prims,
+        rs.accel_seconds * 1e3
+    );
+}
+
 fn info(a: InfoArgs) -> Result<(), CliError> {
     let scene = load_scene(&a.scene, &a.set, &[])?;
-    let rs = prepare(&scene, &a.force)?;
+    let rs = prepare(&scene, &a.force, 0)?;
     let s = &rs.settings;
     println!("scene: {}", a.scene.display());
     println!(

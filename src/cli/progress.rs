@@ -6,6 +6,7 @@ use std::sync::atomic::{AtomicU64, Ordering};
 use std::time::{Duration, Instant};
 
 pub struct Progress {
+    label: String,
     bar: Option<ProgressBar>,
     plain: bool,
     total: u64,
@@ -16,7 +17,8 @@ pub struct Progress {
 }
 
 impl Progress {
-    pub fn new(total: u64, quiet: bool) -> Self {
+    /// `label` prefixes every line (e.g. the frame being rendered).
+    pub fn new(total: u64, quiet: bool, label: &str) -> Self {
         let tty = std::io::stderr().is_terminal();
         let bar = (!quiet && tty).then(|| {
             let b = ProgressBar::with_draw_target(Some(total), ProgressDrawTarget::stderr());
@@ -28,6 +30,11 @@ impl Progress {
             b
         });
         Self {
+            label: if label.is_empty() {
+                "render".into()
+            } else {
+                label.to_string()
+            },
             bar,
             plain: !quiet && !tty,
             total,
@@ -56,7 +63,8 @@ impl Progress {
             {
                 let eta = (self.total.saturating_sub(done)) as f64 / rate.max(1e-9);
                 eprintln!(
-                    "render {:.1}% {:.2} Msamples/s eta {:.0}s",
+                    "{} {:.1}% {:.2} Msamples/s eta {:.0}s",
+                    self.label,
                     100.0 * done as f64 / self.total.max(1) as f64,
                     rate * 1e-6,
                     eta

@@ -2,10 +2,12 @@
 
 pub mod camera;
 pub mod material;
+pub mod motion;
 pub mod shape;
 
 pub use camera::Camera;
 pub use material::Material;
+pub use motion::Motion;
 pub use shape::Shape;
 
 use glam::Affine3A;

@@ -346,7 +346,9 @@ fn encode_exr(path: &Path, img: &Image, meta: &ImageMeta) -> Result<Vec<u8>, Fil
 /// Distinguishes temporary files of concurrent writes from one process.
 static TEMP_COUNTER: AtomicU64 = AtomicU64::new(0);
 
-fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FilmError> {
+/// Writes `bytes` to a temporary file beside `path`, then renames it over `path`: a reader
+/// never sees a partial file, and an interrupted write leaves no file with the final name.
+pub fn write_atomic(path: &Path, bytes: &[u8]) -> Result<(), FilmError> {
     let write_err = |error| FilmError::Write {
         path: path.to_path_buf(),
         error,

@@ -7,3 +7,5 @@ pub mod shapes;
 pub use bounds::Aabb;
 pub use ray::{Ray, offset_ray_origin, spawn_ray, spawn_ray_to};
 pub use shapes::{OrientedBox, Planar, ShapeSample, Sphere, SurfacePoint};
+pub mod motion;
+pub use motion::RigidMotion;

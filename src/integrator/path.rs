@@ -98,8 +98,29 @@ fn power_heuristic(a: f32, b: f32) -> f32 {
 /// MOTION is on.
 #[inline]
 pub fn camera_ray<const MOTION: bool>(ctx: &Ctx, x: u32, y: u32, index: u32) -> PathState {
-    let cam = &ctx.scene.camera;
     let pixel = y * ctx.width + x;
+    let time = if MOTION {
+        let (open, close) = ctx.scene.shutter;
+        open + (close - open) * ctx.sampler.get_1d(pixel, index, DIM_TIME)
+    } else {
+        ctx.scene.shutter.0
+    };
+    // A camera moving within the shutter is evaluated at each ray's own time.
+    let moved;
+    let cam = if MOTION && ctx.scene.camera_moves {
+        let s = &ctx.scene.settings;
+        let path = ctx
+            .scene
+            .camera_path
+            .as_ref()
+            .expect("camera_moves implies a path");
+        moved = path
+            .at(time, &ctx.scene.base_camera)
+            .frame(s.width, s.height);
+        &moved
+    } else {
+        &ctx.scene.camera
+    };
     let u = ctx.sampler.get_2d(pixel, index, DIM_FILM);
     let fx = x as f32 + 0.5 + sampling::sample_tent(u.x);
     let fy = y as f32 + 0.5 + sampling::sample_tent(u.y);
@@ -116,12 +137,6 @@ pub fn camera_ray<const MOTION: bool>(ctx: &Ctx, x: u32, y: u32, index: u32) -> 
         let focus = cam.origin + dir * cam.focus_distance;
         ray = Ray::new(o, (focus - o).normalize());
     }
-    let time = if MOTION {
-        let (open, close) = ctx.scene.shutter;
-        open + (close - open) * ctx.sampler.get_1d(pixel, index, DIM_TIME)
-    } else {
-        0.0
-    };
     PathState {
         ray,
         beta: Vec3::ONE,
@@ -183,7 +198,11 @@ fn below(wt: Vec3, n: Vec3) -> Vec3 {
 /// Processes the vertex where `s.ray` ends: adds emission found there (MIS-weighted), then
 /// either ends the path or scatters it, returning a shadow ray for next-event estimation.
 #[inline]
-pub fn shade(ctx: &Ctx, s: &mut PathState, hit: Option<Hit>) -> Option<ShadowRequest> {
+pub fn shade<const MOTION: bool>(
+    ctx: &Ctx,
+    s: &mut PathState,
+    hit: Option<Hit>,
+) -> Option<ShadowRequest> {
     let scene = ctx.scene;
     let lights = &scene.lights;
     let wo = -s.ray.d;
@@ -203,7 +222,7 @@ pub fn shade(ctx: &Ctx, s: &mut PathState, hit: Option<Hit>) -> Option<ShadowReq
         return None;
     };
     let prims = &scene.prims;
-    let sp = prims.surface(&s.ray, &hit);
+    let sp = prims.surface_at::<MOTION>(&s.ray, &hit, s.time);
     let material = prims.materials[prims.material[hit.prim as usize] as usize];
     if let Material::Light { .. } = material {
         let le = emitted(&material, sp.n, wo);
@@ -211,7 +230,10 @@ pub fn shade(ctx: &Ctx, s: &mut PathState, hit: Option<Hit>) -> Option<ShadowReq
             let w = if s.depth == 0 || s.specular || !ctx.nee {
                 1.0
             } else {
-                mis_emitter(s, lights.pdf_area(prims, hit.prim, s.prev_p, sp.p, sp.n))
+                mis_emitter(
+                    s,
+                    lights.pdf_area::<MOTION>(prims, hit.prim, s.prev_p, sp.p, sp.n, s.time),
+                )
             };
             s.l += s.beta * le * w;
         }
@@ -234,7 +256,7 @@ pub fn shade(ctx: &Ctx, s: &mut PathState, hit: Option<Hit>) -> Option<ShadowReq
             if ctx.nee {
                 let u_sel = ctx.sampler.get_1d(pixel, index, dim);
                 let u_l = ctx.sampler.get_2d(pixel, index, dim + 1);
-                if let Some(ls) = lights.sample(prims, sp.p, u_sel, u_l) {
+                if let Some(ls) = lights.sample::<MOTION>(prims, sp.p, u_sel, u_l, s.time) {
                     let cos = ls.wi.dot(nf);
                     if cos > 0.0 {
                         let bsdf_pdf = cos * std::f32::consts::FRAC_1_PI;

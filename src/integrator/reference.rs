@@ -18,11 +18,11 @@ pub fn render_tile<const MOTION: bool>(
         for k in s0..s1 {
             let mut s = camera_ray::<MOTION>(ctx, x, y, k);
             while s.alive {
-                let hit = ctx.scene.intersect(&s.ray, f32::INFINITY);
+                let hit = ctx.scene.intersect::<MOTION>(&s.ray, f32::INFINITY, s.time);
                 stats.rays += 1;
-                if let Some(r) = shade(ctx, &mut s, hit) {
+                if let Some(r) = shade::<MOTION>(ctx, &mut s, hit) {
                     stats.shadow_rays += 1;
-                    if !ctx.scene.occluded(&r.ray, r.t_max) {
+                    if !ctx.scene.occluded::<MOTION>(&r.ray, r.t_max, s.time) {
                         s.l += r.contrib;
                     }
                 }

@@ -96,6 +96,7 @@ struct ShadowQueue {
     o: Vec<Vec3>,
     d: Vec<Vec3>,
     t_max: Vec<f32>,
+    time: Vec<f32>,
     contrib: Vec<Vec3>,
     slot: Vec<u32>,
 }
@@ -107,14 +108,16 @@ impl ShadowQueue {
             o: vec![Vec3::ZERO; cap],
             d: vec![Vec3::ZERO; cap],
             t_max: vec![0.0; cap],
+            time: vec![0.0; cap],
             contrib: vec![Vec3::ZERO; cap],
             slot: vec![0; cap],
         }
     }
 
     #[inline]
-    fn push(&mut self, r: &ShadowRequest, slot: usize) {
+    fn push(&mut self, r: &ShadowRequest, slot: usize, time: f32) {
         let i = self.len;
+        self.time[i] = time;
         self.o[i] = r.ray.o;
         self.d[i] = r.ray.d;
         self.t_max[i] = r.t_max;
@@ -185,15 +188,17 @@ pub fn render_tile<const MOTION: bool>(
         // Stage 2, intersect: closest hits into a small-record queue.
         for i in 0..n {
             let ray = Ray::new(q.rays.o[i], q.rays.d[i]);
-            q.hits[i] = ctx.scene.intersect(&ray, f32::INFINITY);
+            q.hits[i] = ctx
+                .scene
+                .intersect::<MOTION>(&ray, f32::INFINITY, q.rays.time[i]);
         }
         stats.rays += n as u64;
         // Stages 3–4, emission and shading: one vertex per path, light samples queued.
         q.shadow.len = 0;
         for i in 0..n {
             let mut s = q.rays.load(i);
-            if let Some(r) = shade(ctx, &mut s, q.hits[i]) {
-                q.shadow.push(&r, i);
+            if let Some(r) = shade::<MOTION>(ctx, &mut s, q.hits[i]) {
+                q.shadow.push(&r, i, s.time);
             }
             q.rays.store(i, &s);
         }
@@ -201,7 +206,7 @@ pub fn render_tile<const MOTION: bool>(
         let sh = &q.shadow;
         for j in 0..sh.len {
             let ray = Ray::new(sh.o[j], sh.d[j]);
-            if !ctx.scene.occluded(&ray, sh.t_max[j]) {
+            if !ctx.scene.occluded::<MOTION>(&ray, sh.t_max[j], sh.time[j]) {
                 q.rays.l[sh.slot[j] as usize] += sh.contrib[j];
             }
         }

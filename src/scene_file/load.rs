@@ -2,7 +2,8 @@
 
 use super::error::{SceneError, context_at, offset_of};
 use super::schema;
-use crate::components::{Camera, Material, Name, Shape, Transform};
+use crate::components::camera::{CameraKey, CameraPath};
+use crate::components::{Camera, Material, Motion, Name, Shape, Transform};
 use glam::{Affine3A, Quat, Vec3};
 use std::path::{Path, PathBuf};
 
@@ -26,6 +27,8 @@ pub struct LoadedScene {
     pub path: PathBuf,
     pub world: hecs::World,
     pub camera: Camera,
+    /// The animated camera path, when the scene has keyframes.
+    pub camera_path: Option<CameraPath>,
     pub render: RenderSettings,
     /// Radiance of the constant environment (zero when absent).
     pub environment: Vec3,
@@ -225,6 +228,37 @@ fn build_world(scene: schema::Scene, path: &Path, hash: u64) -> Result<LoadedSce
         wavelengths: r.integrator.wavelengths.0,
         sampler: r.integrator.sampler,
     };
+    let camera_path = scene.animation.as_ref().map(|a| CameraPath {
+        fps: a.fps,
+        keys: a
+            .keyframes
+            .iter()
+            .map(|k| CameraKey {
+                frame: k.frame as f32,
+                position: k.position.vec(),
+                look_at: k.look_at.vec(),
+                up: k.up.map_or(camera.up, |u| u.vec()),
+                fov_y: k.fov_y.map_or(camera.fov_y, |f| f.0),
+                focus_distance: k.focus_distance.map_or(camera.focus_distance, |f| f.0),
+            })
+            .collect(),
+    });
+    if let Some(cp) = &camera_path {
+        for (i, k) in cp.keys.iter().enumerate() {
+            let fwd = k.look_at - k.position;
+            if fwd.length_squared() == 0.0
+                || fwd.cross(k.up).length_squared()
+                    <= 1e-12 * fwd.length_squared() * k.up.length_squared()
+            {
+                return Err(SceneError::Entity {
+                    path: path.to_path_buf(),
+                    entity: format!("animation keyframe {i}"),
+                    field: "look_at",
+                    message: "look_at must differ from position, and up must not be parallel to the view direction".into(),
+                });
+            }
+        }
+    }
     let environment = match &scene.environment {
         Some(schema::Environment::Constant(e)) => e.0.vec(),
         None => Vec3::ZERO,
@@ -303,12 +337,24 @@ fn build_world(scene: schema::Scene, path: &Path, hash: u64) -> Result<LoadedSce
                 }
             }
         };
-        world.spawn((Name(name), shape, transform, material));
+        let entity = world.spawn((Name(name), shape, transform, material));
+        if let Some(m) = &e.motion {
+            let motion = Motion {
+                velocity: m.velocity.map_or(glam::Vec3::ZERO, |v| v.vec()),
+                angular_velocity: m.angular_velocity.map_or(glam::Vec3::ZERO, |v| v.vec()),
+            };
+            if !motion.is_static() {
+                world
+                    .insert_one(entity, motion)
+                    .expect("entity was just spawned");
+            }
+        }
     }
     Ok(LoadedScene {
         path: path.to_path_buf(),
         world,
         camera,
+        camera_path,
         render,
         environment,
         hash,

@@ -17,7 +17,7 @@ pub struct Scene {
     pub render: Render,
     pub camera: Camera,
     #[serde(default)]
-    pub animation: Option<NotYetAnimation>,
+    pub animation: Option<Animation>,
     #[serde(default)]
     pub environment: Option<Environment>,
     #[serde(default)]
@@ -193,6 +193,75 @@ impl TryFrom<ShutterSpec> for Shutter {
     }
 }
 
+/// Rigid motion of an entity: scene units per frame, and degrees per frame about the object
+/// origin (the transform's translation), applied as R = Rz·Ry·Rx of the angles times time.
+#[derive(Clone, Debug, Default, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Motion {
+    #[serde(default)]
+    pub velocity: Option<V3>,
+    #[serde(default)]
+    pub angular_velocity: Option<V3>,
+}
+
+/// A camera path: keyframes indexed by frame, interpolated smoothly between them.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields, try_from = "AnimationSpec")]
+pub struct Animation {
+    pub fps: u32,
+    pub keyframes: Vec<Keyframe>,
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct AnimationSpec {
+    #[serde(default = "default_fps")]
+    fps: u32,
+    keyframes: Vec<Keyframe>,
+}
+
+fn default_fps() -> u32 {
+    24
+}
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Keyframe {
+    pub frame: u32,
+    pub position: V3,
+    pub look_at: V3,
+    #[serde(default)]
+    pub up: Option<V3>,
+    #[serde(default)]
+    pub fov_y: Option<FovY>,
+    #[serde(default)]
+    pub focus_distance: Option<Positive>,
+}
+
+impl TryFrom<AnimationSpec> for Animation {
+    type Error = String;
+    fn try_from(a: AnimationSpec) -> Result<Self, String> {
+        if !(1..=1000).contains(&a.fps) {
+            return Err(format!("fps must be in 1..=1000, got {}", a.fps));
+        }
+        if a.keyframes.is_empty() {
+            return Err("an animation needs at least one keyframe".into());
+        }
+        for w in a.keyframes.windows(2) {
+            if w[1].frame <= w[0].frame {
+                return Err(format!(
+                    "keyframes must have increasing frame numbers, got {} after {}",
+                    w[1].frame, w[0].frame
+                ));
+            }
+        }
+        Ok(Animation {
+            fps: a.fps,
+            keyframes: a.keyframes,
+        })
+    }
+}
+
 /// Background radiance seen by escaping rays.
 #[derive(Clone, Debug, Deserialize)]
 pub enum Environment {
@@ -214,7 +283,7 @@ pub struct Entity {
     #[serde(default)]
     pub texture: Option<NotYetTexture>,
     #[serde(default)]
-    pub motion: Option<NotYetMotion>,
+    pub motion: Option<Motion>,
     #[serde(default)]
     pub medium: Option<NotYetMedium>,
     #[serde(default)]
@@ -612,8 +681,6 @@ macro_rules! not_yet {
     };
 }
 
-not_yet!(NotYetAnimation, "animation", "animated camera sequences");
 not_yet!(NotYetTexture, "texture", "textures and normal maps");
-not_yet!(NotYetMotion, "motion", "motion blur");
 not_yet!(NotYetMedium, "medium", "participating media");
 not_yet!(NotYetLight, "light", "point and spot lights");

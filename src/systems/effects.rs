@@ -1,6 +1,7 @@
 //! `detect_effects`: which optional parts of light transport a scene needs.
 
-use crate::components::{Camera, Name};
+use crate::components::camera::CameraPath;
+use crate::components::{Camera, Motion, Name};
 use std::fmt;
 
 /// One optional effect of the renderer.
@@ -102,8 +103,13 @@ impl fmt::Display for Effects {
     }
 }
 
-/// Decides the effect set from the world and the camera.
-pub fn detect_effects(world: &hecs::World, camera: &Camera) -> Effects {
+/// Decides the effect set from the world and the camera, for the shutter interval `shutter`.
+pub fn detect_effects(
+    world: &hecs::World,
+    camera: &Camera,
+    path: Option<&CameraPath>,
+    shutter: (f32, f32),
+) -> Effects {
     let mut fx = Effects::default();
     if camera.aperture_radius > 0.0 {
         fx.set(
@@ -114,14 +120,56 @@ pub fn detect_effects(world: &hecs::World, camera: &Camera) -> Effects {
     } else {
         fx.set(Effect::Lens, false, "pinhole camera (aperture radius 0)");
     }
-    // The schema refuses motion, dispersive IORs, spectral emitters, media and textures until
-    // they are simulated, so a loaded world never asks for them.
-    let entities = world.query::<&Name>().iter().count();
-    fx.set(
-        Effect::Motion,
-        false,
-        format!("no Motion component on any of {entities} entities and a static camera"),
-    );
+    let moving: Vec<String> = world
+        .query::<(&Name, &Motion)>()
+        .iter()
+        .filter(|(_, m)| !m.is_static())
+        .map(|(n, _)| format!("\"{}\"", n.0))
+        .collect();
+    let camera_moves = path.is_some_and(|p| p.moves_within(shutter.0, shutter.1));
+    let shutter_open = shutter.1 > shutter.0;
+    if !moving.is_empty() && shutter_open {
+        let more = if moving.len() > 3 {
+            format!(" and {} more", moving.len() - 3)
+        } else {
+            String::new()
+        };
+        fx.set(
+            Effect::Motion,
+            true,
+            format!(
+                "Motion on entity {}{}{}",
+                moving[..moving.len().min(3)].join(", "),
+                more,
+                if camera_moves {
+                    "; camera keyframes move within the shutter"
+                } else {
+                    ""
+                }
+            ),
+        );
+    } else if camera_moves && shutter_open {
+        fx.set(
+            Effect::Motion,
+            true,
+            "camera keyframes move within the shutter",
+        );
+    } else if !moving.is_empty() {
+        fx.set(
+            Effect::Motion,
+            false,
+            "the shutter is closed (open = close)",
+        );
+    } else {
+        let entities = world.query::<&Name>().iter().count();
+        fx.set(
+            Effect::Motion,
+            false,
+            format!("no Motion component on any of {entities} entities and a static camera"),
+        );
+    }
+    // The schema refuses dispersive IORs, spectral emitters, media and textures until they
+    // are simulated, so a loaded world never asks for them.
     fx.set(
         Effect::Spectral,
         false,

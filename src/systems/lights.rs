@@ -38,14 +38,16 @@ impl Lights {
         self.lights.is_empty()
     }
 
-    /// Chooses a light by power and samples a direction to it from `p`.
+    /// Chooses a light by power and samples a direction to it from `p`. A moving emitter is
+    /// sampled in its rest pose at `time` (a rigid map keeps solid-angle densities).
     #[inline]
-    pub fn sample(
+    pub fn sample<const MOTION: bool>(
         &self,
         prims: &Primitives,
         p: Vec3,
         u_select: f32,
         u: Vec2,
+        time: f32,
     ) -> Option<LightSample> {
         if self.lights.is_empty() {
             return None;
@@ -63,12 +65,18 @@ impl Lights {
             }
             LightKind::Area(prim) => {
                 let l = prims.local[prim as usize] as usize;
-                let s = match prims.kind[prim as usize] {
-                    PrimKind::Sphere => prims.spheres[l].sample(p, u),
-                    PrimKind::Rect => prims.planars[l].sample(p, u, false),
-                    PrimKind::Disk => prims.planars[l].sample(p, u, true),
+                let motion = if MOTION { prims.motion_of(prim) } else { None };
+                let p_rest = motion.map_or(p, |m| m.point_to_rest(p, time));
+                let mut s = match prims.kind[prim as usize] {
+                    PrimKind::Sphere => prims.spheres[l].sample(p_rest, u),
+                    PrimKind::Rect => prims.planars[l].sample(p_rest, u, false),
+                    PrimKind::Disk => prims.planars[l].sample(p_rest, u, true),
                     PrimKind::Box => None,
                 }?;
+                if let Some(m) = motion {
+                    s.p = m.point_to_world(s.p, time);
+                    s.n = m.vector_to_world(s.n, time);
+                }
                 let d = s.p - p;
                 let wi = d.normalize_or_zero();
                 let m = &prims.materials[prims.material[prim as usize] as usize];
@@ -86,7 +94,23 @@ impl Lights {
     /// Density with which `sample` from `p` would have produced the point `q` (normal `n`)
     /// on emissive primitive `prim`: needed to weight emitters found by chance.
     #[inline]
-    pub fn pdf_area(&self, prims: &Primitives, prim: u32, p: Vec3, q: Vec3, n: Vec3) -> f32 {
+    pub fn pdf_area<const MOTION: bool>(
+        &self,
+        prims: &Primitives,
+        prim: u32,
+        p: Vec3,
+        q: Vec3,
+        n: Vec3,
+        time: f32,
+    ) -> f32 {
+        let (p, q, n) = match prims.motion_of(prim) {
+            Some(m) if MOTION => (
+                m.point_to_rest(p, time),
+                m.point_to_rest(q, time),
+                m.vector_to_rest(n, time),
+            ),
+            _ => (p, q, n),
+        };
         let li = prims.light[prim as usize];
         let pmf = self.table.pmf(li as usize);
         let l = prims.local[prim as usize] as usize;

@@ -9,7 +9,8 @@ pub use effects::{Effect, Effects, detect_effects};
 pub use lights::{LightKind, LightSample, Lights, gather_lights};
 pub use primitives::{Hit, PrimKind, Primitives, gather_primitives};
 
-use crate::components::camera::CameraFrame;
+use crate::components::Camera;
+use crate::components::camera::{CameraFrame, CameraPath};
 use crate::geometry::{Aabb, Ray};
 use crate::kdtree::{KdParams, KdTree};
 use crate::scene_file::{LoadedScene, RenderSettings};
@@ -20,7 +21,15 @@ pub struct RenderScene {
     pub prims: Primitives,
     pub accel: KdTree,
     pub lights: Lights,
+    /// The camera at the start of the frame's shutter; what every ray uses unless the camera
+    /// moves within the shutter.
     pub camera: CameraFrame,
+    /// The camera at rest and its path, for cameras that move within the shutter.
+    pub base_camera: Camera,
+    pub camera_path: Option<CameraPath>,
+    pub camera_moves: bool,
+    pub frame: u32,
+    /// Shutter interval of this frame in scene time (frames): [frame + open, frame + close].
     pub shutter: (f32, f32),
     pub environment: Vec3,
     pub effects: Effects,
@@ -33,19 +42,49 @@ pub fn build_accel(prims: &Primitives, params: &KdParams) -> KdTree {
     KdTree::build(prims, params)
 }
 
-/// Runs the systems in order: effects, primitives, kd-tree, lights.
+/// Runs the systems in order for frame 0: effects, primitives, kd-tree, lights.
 pub fn prepare(scene: &LoadedScene, params: &KdParams) -> RenderScene {
-    let effects = detect_effects(&scene.world, &scene.camera);
+    prepare_frame(scene, params, 0)
+}
+
+/// The shutter interval of `frame` in scene time.
+pub fn shutter_of(scene: &LoadedScene, frame: u32) -> (f32, f32) {
+    let (open, close) = scene.camera.shutter;
+    (frame as f32 + open, frame as f32 + close)
+}
+
+/// Runs the systems for one frame of the scene.
+pub fn prepare_frame(scene: &LoadedScene, params: &KdParams, frame: u32) -> RenderScene {
+    let shutter = shutter_of(scene, frame);
+    let effects = detect_effects(
+        &scene.world,
+        &scene.camera,
+        scene.camera_path.as_ref(),
+        shutter,
+    );
     let mut prims = gather_primitives(&scene.world);
+    prims.sweep = shutter;
     let t0 = std::time::Instant::now();
     let accel = build_accel(&prims, params);
     let accel_seconds = t0.elapsed().as_secs_f64();
     let bounds: Aabb = accel.bounds();
     let lights = gather_lights(&mut prims, scene.environment, &bounds);
     let s = &scene.render;
+    let camera_at = |t: f32| match &scene.camera_path {
+        Some(p) => p.at(t, &scene.camera),
+        None => scene.camera,
+    };
+    let camera_moves = scene
+        .camera_path
+        .as_ref()
+        .is_some_and(|p| p.moves_within(shutter.0, shutter.1));
     RenderScene {
-        camera: scene.camera.frame(s.width, s.height),
-        shutter: scene.camera.shutter,
+        camera: camera_at(shutter.0).frame(s.width, s.height),
+        base_camera: scene.camera,
+        camera_path: scene.camera_path.clone(),
+        camera_moves,
+        frame,
+        shutter,
         prims,
         accel,
         lights,
@@ -57,23 +96,55 @@ pub fn prepare(scene: &LoadedScene, params: &KdParams) -> RenderScene {
 }
 
 impl RenderScene {
-    /// Closest hit along `ray` before `t_max`.
+    /// Moves a prepared scene to another frame of the same loaded scene: the camera follows
+    /// its path, and the kd-tree is rebuilt only when primitives move (their bounds cover
+    /// the new shutter interval). A static scene keeps its tree for the whole series.
+    pub fn set_frame(&mut self, scene: &LoadedScene, params: &KdParams, frame: u32) {
+        let shutter = shutter_of(scene, frame);
+        self.frame = frame;
+        self.shutter = shutter;
+        self.effects = detect_effects(
+            &scene.world,
+            &scene.camera,
+            scene.camera_path.as_ref(),
+            shutter,
+        );
+        let cam = match &scene.camera_path {
+            Some(p) => p.at(shutter.0, &scene.camera),
+            None => scene.camera,
+        };
+        self.camera = cam.frame(self.settings.width, self.settings.height);
+        self.camera_moves = scene
+            .camera_path
+            .as_ref()
+            .is_some_and(|p| p.moves_within(shutter.0, shutter.1));
+        if self.prims.has_motion() {
+            self.prims.sweep = shutter;
+            let t0 = std::time::Instant::now();
+            self.accel = build_accel(&self.prims, params);
+            self.accel_seconds = t0.elapsed().as_secs_f64();
+        }
+    }
+
+    /// Closest hit along `ray` before `t_max`, at `time` when MOTION is on.
     #[inline]
-    pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<Hit> {
+    pub fn intersect<const MOTION: bool>(&self, ray: &Ray, t_max: f32, time: f32) -> Option<Hit> {
         let mut best = None;
         self.accel.closest_hit(ray, t_max, |prim, t_max| {
-            let (t, u, v) = self.prims.intersect(prim, ray, t_max)?;
+            let (t, u, v) = self.prims.intersect_at::<MOTION>(prim, ray, t_max, time)?;
             best = Some(Hit { t, prim, u, v });
             Some(t)
         })?;
         best
     }
 
-    /// Whether anything blocks `ray` before `t_max`.
+    /// Whether anything blocks `ray` before `t_max`, at `time` when MOTION is on.
     #[inline]
-    pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
+    pub fn occluded<const MOTION: bool>(&self, ray: &Ray, t_max: f32, time: f32) -> bool {
         self.accel.any_hit(ray, t_max, |prim, t_max| {
-            self.prims.intersect(prim, ray, t_max).is_some()
+            self.prims
+                .intersect_at::<MOTION>(prim, ray, t_max, time)
+                .is_some()
         })
     }
 }

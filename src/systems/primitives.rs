@@ -1,8 +1,8 @@
 //! `gather_primitives`: flattens the world's shapes into per-kind arrays for the hot loop,
 //! keeping each primitive's entity for messages and statistics.
 
-use crate::components::{Material, Name, Shape, Transform};
-use crate::geometry::{Aabb, OrientedBox, Planar, Ray, Sphere, SurfacePoint};
+use crate::components::{Material, Motion, Name, Shape, Transform};
+use crate::geometry::{Aabb, OrientedBox, Planar, Ray, RigidMotion, Sphere, SurfacePoint};
 use crate::kdtree::KdPrimitives;
 use glam::Vec3;
 
@@ -26,6 +26,7 @@ pub struct Hit {
 }
 
 pub const NO_LIGHT: u32 = u32::MAX;
+pub const NO_MOTION: u32 = u32::MAX;
 
 /// Structure-of-arrays primitive store. Index `i` addresses `kind`, `local`, `material`,
 /// `light` and `entity`; `local[i]` indexes the array of its kind.
@@ -37,6 +38,11 @@ pub struct Primitives {
     /// Index into the light list when the primitive emits, else `NO_LIGHT`.
     pub light: Vec<u32>,
     pub entity: Vec<hecs::Entity>,
+    /// Index into `motions` for moving primitives, else `NO_MOTION`.
+    pub motion: Vec<u32>,
+    pub motions: Vec<RigidMotion>,
+    /// The time interval the kd-tree's bounds must cover (frames).
+    pub sweep: (f32, f32),
     pub spheres: Vec<Sphere>,
     pub planars: Vec<Planar>,
     pub boxes: Vec<OrientedBox>,
@@ -53,7 +59,16 @@ impl Primitives {
         self.kind.is_empty()
     }
 
+    /// Bounds of primitive `i` over the whole `sweep` interval.
     pub fn bounds_of(&self, i: u32) -> Aabb {
+        let rest = self.rest_bounds(i);
+        match self.motion_of(i) {
+            Some(m) => m.sweep_bounds(&rest, self.sweep.0, self.sweep.1),
+            None => rest,
+        }
+    }
+
+    fn rest_bounds(&self, i: u32) -> Aabb {
         let l = self.local[i as usize] as usize;
         match self.kind[i as usize] {
             PrimKind::Sphere => self.spheres[l].bounds(),
@@ -63,7 +78,48 @@ impl Primitives {
         }
     }
 
-    /// Intersects primitive `i`: `Some((t, u, v))` for a hit in (0, t_max).
+    #[inline]
+    pub fn motion_of(&self, i: u32) -> Option<&RigidMotion> {
+        let m = self.motion[i as usize];
+        (m != NO_MOTION).then(|| &self.motions[m as usize])
+    }
+
+    pub fn has_motion(&self) -> bool {
+        !self.motions.is_empty()
+    }
+
+    /// Intersects primitive `i` at `time`: a moving primitive is tested in its rest pose.
+    /// Without MOTION no time is looked at.
+    #[inline]
+    pub fn intersect_at<const MOTION: bool>(
+        &self,
+        i: u32,
+        ray: &Ray,
+        t_max: f32,
+        time: f32,
+    ) -> Option<(f32, f32, f32)> {
+        if MOTION && let Some(m) = self.motion_of(i) {
+            return self.intersect(i, &m.ray_to_rest(ray, time), t_max);
+        }
+        self.intersect(i, ray, t_max)
+    }
+
+    /// Surface data at `time` (see `intersect_at`).
+    #[inline]
+    pub fn surface_at<const MOTION: bool>(&self, ray: &Ray, hit: &Hit, time: f32) -> SurfacePoint {
+        if MOTION && let Some(m) = self.motion_of(hit.prim) {
+            let sp = self.surface(&m.ray_to_rest(ray, time), hit);
+            return SurfacePoint {
+                p: m.point_to_world(sp.p, time),
+                n: m.vector_to_world(sp.n, time),
+                front: sp.front,
+            };
+        }
+        self.surface(ray, hit)
+    }
+
+    /// Intersects primitive `i` in the pose of time 0: `Some((t, u, v))` for a hit in
+    /// (0, t_max).
     #[inline]
     pub fn intersect(&self, i: u32, ray: &Ray, t_max: f32) -> Option<(f32, f32, f32)> {
         let l = self.local[i as usize] as usize;
@@ -117,13 +173,37 @@ impl KdPrimitives for Primitives {
 /// spawn order so primitive indices, and thus images, are reproducible.
 pub fn gather_primitives(world: &hecs::World) -> Primitives {
     let mut p = Primitives::default();
-    let mut rows: Vec<(hecs::Entity, Shape, Transform, Material, String)> = world
-        .query::<(hecs::Entity, &Shape, &Transform, &Material, &Name)>()
+    type Row = (
+        hecs::Entity,
+        Shape,
+        Transform,
+        Material,
+        String,
+        Option<Motion>,
+    );
+    let mut rows: Vec<Row> = world
+        .query::<(
+            hecs::Entity,
+            &Shape,
+            &Transform,
+            &Material,
+            &Name,
+            Option<&Motion>,
+        )>()
         .iter()
-        .map(|(e, s, t, m, n)| (e, *s, *t, *m, n.0.clone()))
+        .map(|(e, s, t, m, n, mo)| (e, *s, *t, *m, n.0.clone(), mo.copied()))
         .collect();
     rows.sort_by_key(|r| r.0.id());
-    for (entity, shape, transform, material, name) in rows {
+    for (entity, shape, transform, material, name, motion) in rows {
+        let moving = motion.filter(|m| !m.is_static()).map(|m| {
+            p.motions.push(RigidMotion {
+                pivot: transform.to_world.translation.into(),
+                velocity: m.velocity,
+                angular: m.angular_velocity * (std::f32::consts::PI / 180.0),
+            });
+            (p.motions.len() - 1) as u32
+        });
+        p.motion.push(moving.unwrap_or(NO_MOTION));
         let m = p.materials.len() as u32;
         p.materials.push(material);
         let tw = transform.to_world;

@@ -1,0 +1,172 @@
+//! Depth of field, motion blur and frame series.
+
+mod common;
+use common::render::{image, run, scene, scene_file};
+use prism::film::Image;
+use prism::integrator::Integrator;
+use prism::systems::Effect;
+use std::path::Path;
+
+/// Intensity-weighted centroid and second moments of channel 1 (pixel-centre coordinates).
+fn moments(img: &Image) -> (f64, f64, f64, f64, f64) {
+    let (mut s, mut sx, mut sy) = (0.0, 0.0, 0.0);
+    for y in 0..img.height {
+        for x in 0..img.width {
+            let v = img.pixels[(y * img.width + x) as usize][1] as f64;
+            s += v;
+            sx += v * (x as f64 + 0.5);
+            sy += v * (y as f64 + 0.5);
+        }
+    }
+    let (cx, cy) = (sx / s, sy / s);
+    let (mut vx, mut vy) = (0.0, 0.0);
+    for y in 0..img.height {
+        for x in 0..img.width {
+            let v = img.pixels[(y * img.width + x) as usize][1] as f64;
+            vx += v * (x as f64 + 0.5 - cx).powi(2);
+            vy += v * (y as f64 + 0.5 - cy).powi(2);
+        }
+    }
+    (s, cx, cy, vx / s, vy / s)
+}
+
+/// Variance per axis of the tent filter of radius 1 px: ∫ x² (1 − |x|) dx = 1/6.
+const TENT_VAR: f64 = 1.0 / 6.0;
+
+/// A tiny emitter at depth `z` seen through a lens of radius `a` focused at `f`; 96×96 px,
+/// 20° vertical field of view.
+fn point_image(z: f32, a: f32, f: f32) -> Image {
+    image(&format!(
+        r#"Scene(
+    render: (width: 96, height: 96, spp: 1024, max_depth: 0, seed: 5),
+    camera: (position: (0.0, 0.0, 0.0), look_at: (0.0, 0.0, -1.0), fov_y: 20.0,
+             lens: (aperture_radius: {a}, focus_distance: {f})),
+    entities: [ (name: "point", shape: Sphere(center: (0.0, 0.0, -{z}), radius: {r}),
+                 material: Light(emission: Rgb(1.0, 1.0, 1.0))) ],
+)"#,
+        r = z * 0.0004
+    ))
+}
+
+#[test]
+fn a_point_on_the_focal_plane_images_to_a_point() {
+    let img = point_image(10.0, 0.5, 10.0);
+    let (_, cx, cy, vx, vy) = moments(&img);
+    assert!(
+        (cx - 48.0).abs() < 0.05 && (cy - 48.0).abs() < 0.05,
+        "centre {cx} {cy}"
+    );
+    // Only the film filter spreads it. The point sits on a pixel corner (the image centre of
+    // an even-sized film), so the tent of radius 1 px gives the two pixels on each side
+    // weight 1/2 each: variance exactly 1/4 per axis, RMS radius √(1/2) ≈ 0.71 px.
+    let rms = (vx + vy).sqrt();
+    assert!(rms <= 1.0, "spread {rms} px");
+    assert!(
+        (vx - 0.25).abs() < 0.01 && (vy - 0.25).abs() < 0.01,
+        "{vx} {vy}"
+    );
+}
+
+#[test]
+fn a_point_off_the_focal_plane_images_to_the_circle_of_confusion() {
+    let (a, f, z) = (0.25f64, 10.0f64, 5.0f64);
+    let img = point_image(z as f32, a as f32, f as f32);
+    // Thin lens: rays through the lens point l cross the focal plane at l·(1 − f/z) from the
+    // pinhole image, so the disc on the film has radius a·|1 − f/z| / (f·tan(fov/2)) · H/2.
+    let half = (10.0f64).to_radians().tan();
+    let r_px = a * (1.0 - f / z).abs() / (f * half) * 48.0;
+    let (_, _, _, vx, vy) = moments(&img);
+    // A uniform disc of radius R has variance R²/4 per axis; the tent filter adds its own.
+    let r_measured = (2.0 * (vx + vy - 2.0 * TENT_VAR)).sqrt();
+    assert!(
+        r_px > 5.0,
+        "the test needs a disc of several pixels: {r_px}"
+    );
+    assert!(
+        (2.0 * r_measured / (2.0 * r_px) - 1.0).abs() < 0.05,
+        "diameter {} px, thin lens predicts {} px",
+        2.0 * r_measured,
+        2.0 * r_px
+    );
+}
+
+/// An emissive disc facing the camera, moving along x by `v` units per frame.
+fn moving_disc(v: f32) -> String {
+    format!(
+        r#"Scene(
+    render: (width: 128, height: 64, spp: 256, max_depth: 0, seed: 9),
+    camera: (position: (0.0, 0.0, 10.0), look_at: (0.0, 0.0, 0.0), fov_y: 20.0,
+             shutter: (open: 0.0, close: 0.5)),
+    entities: [ (name: "disc", shape: Disk(center: (-0.8, 0.0, 0.0), normal: (0.0, 0.0, 1.0), radius: 0.3),
+                 material: Light(emission: Rgb(1.0, 1.0, 1.0)),
+                 motion: (velocity: ({v}, 0.0, 0.0))) ],
+)"#
+    )
+}
+
+#[test]
+fn motion_blur_keeps_energy_and_streaks_by_the_displacement() {
+    let still = image(&moving_disc(0.0));
+    let moving = image(&moving_disc(2.4));
+    let (s0, cx0, cy0, vx0, _) = moments(&still);
+    let (s1, cx1, cy1, vx1, _) = moments(&moving);
+    assert!((s1 / s0 - 1.0).abs() < 0.01, "image integral {s1} vs {s0}");
+    // Over half a frame the disc moves 1.2 units; the image plane at distance 10 with a 20°
+    // field over 64 px maps one unit to 32 / (10 tan 10°) px.
+    let px_per_unit = 32.0 / (10.0 * (10.0f64).to_radians().tan());
+    let d = 1.2 * px_per_unit;
+    assert!(
+        (cx1 - cx0 - d / 2.0).abs() < 0.25,
+        "centroid moved {} px, expected {}",
+        cx1 - cx0,
+        d / 2.0
+    );
+    assert!((cy1 - cy0).abs() < 0.05);
+    // Uniform motion convolves the image with a box of width d: variance grows by d²/12.
+    let grown = vx1 - vx0;
+    assert!(
+        (grown / (d * d / 12.0) - 1.0).abs() < 0.05,
+        "streak variance {grown}, expected {}",
+        d * d / 12.0
+    );
+}
+
+#[test]
+fn static_pinhole_scenes_draw_no_lens_or_time_samples() {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.ron");
+    let s = scene_file(
+        &path,
+        &[
+            ("render.width", "24"),
+            ("render.height", "24"),
+            ("render.spp", "8"),
+        ],
+    );
+    assert!(!s.effects.has(Effect::Lens) && !s.effects.has(Effect::Motion));
+    // The image is bit for bit the one the renderer made before lens and time sampling
+    // existed: absent effects leave every other sample dimension where it was.
+    let out = run(&s, Integrator::Wavefront);
+    let mut h: u64 = 0xcbf2_9ce4_8422_2325;
+    for p in out.image().pixels {
+        for c in p {
+            for b in c.to_bits().to_le_bytes() {
+                h = (h ^ b as u64).wrapping_mul(0x0100_0000_01b3);
+            }
+        }
+    }
+    assert_eq!(h, GOLDEN_CORNELL_24, "{h:#x}");
+}
+
+/// Hash of the pixels of `cornell.ron` at 24×24 and 8 spp, as rendered before the LENS and
+/// MOTION effects were implemented.
+const GOLDEN_CORNELL_24: u64 = 0x66bf_0990_eed6_a5f0;
+
+#[test]
+fn forcing_motion_on_a_static_scene_changes_nothing() {
+    let text = moving_disc(0.0);
+    let mut a = scene(&text);
+    let plain = run(&a, Integrator::Wavefront);
+    a.effects.force(Effect::Motion).unwrap();
+    let forced = run(&a, Integrator::Wavefront);
+    assert_eq!(plain.sums, forced.sums);
+}
