@@ -1,5 +1,6 @@
 //! The `prism` command line: render, info, compare.
 
+pub mod farm;
 pub mod frames;
 mod progress;
 
@@ -31,6 +32,13 @@ pub enum Command {
     Info(InfoArgs),
     /// Print RMSE, relMSE and the maximum error between an image and a reference (B).
     Compare { a: PathBuf, b: PathBuf },
+    /// Combine EXR sample batches of one image, weighted by their sample counts.
+    Merge {
+        #[arg(required = true)]
+        parts: Vec<PathBuf>,
+        #[arg(short, long)]
+        output: PathBuf,
+    },
 }
 
 #[derive(Args, Debug)]
@@ -76,6 +84,16 @@ pub struct RenderArgs {
     /// With --frames: also write the range as an animated GIF.
     #[arg(long, requires = "frames")]
     pub gif: Option<PathBuf>,
+    /// With --frames: render only shard I of N (frames f with f mod N = I).
+    #[arg(long, requires = "frames", value_parser = farm::parse_shard, conflicts_with = "shard_from_env")]
+    pub shard: Option<(u32, u32)>,
+    /// With --frames: take the shard index I from this environment variable (e.g.
+    /// SLURM_ARRAY_TASK_ID, JOB_COMPLETION_INDEX); N comes from --shard-count.
+    #[arg(long, requires = "frames")]
+    pub shard_from_env: Option<String>,
+    /// The number of shards N for --shard-from-env.
+    #[arg(long, requires = "shard_from_env")]
+    pub shard_count: Option<u32>,
     /// Use the per-path reference integrator instead of the wavefront one.
     #[arg(long, hide = true)]
     pub reference: bool,
@@ -151,6 +169,17 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
     match cli.command {
         Command::Render(a) => render(a),
         Command::Info(a) => info(a),
+        Command::Merge { parts, output } => {
+            let (spp, offset) = farm::merge(&parts, &output)?;
+            eprintln!(
+                "wrote {} ({} parts, samples {}..{})",
+                output.display(),
+                parts.len(),
+                offset,
+                offset + spp as u64
+            );
+            Ok(())
+        }
         Command::Compare { a, b } => {
             let m = film::compare_files(&a, &b)?;
             println!("RMSE: {:.6e}", m.rmse);
@@ -303,12 +332,20 @@ fn render_frames(
     range: std::ops::Range<u32>,
     template: &Path,
 ) -> Result<(), CliError> {
-    let n = range.len();
+    let list: Vec<u32> = match (&a.shard, &a.shard_from_env) {
+        (Some((i, n)), _) => farm::shard_frames(range.clone(), *i, *n),
+        (None, Some(var)) => {
+            let (i, n) = farm::shard_from_env(var, a.shard_count)?;
+            farm::shard_frames(range.clone(), i, n)
+        }
+        (None, None) => range.clone().collect(),
+    };
+    let n = list.len();
     let mut rs: Option<RenderScene> = None;
     let start = std::time::Instant::now();
     let mut rendered = 0u32;
     let mut written = Vec::with_capacity(n);
-    for (k, f) in range.clone().enumerate() {
+    for (k, f) in list.iter().copied().enumerate() {
         let path = frames::frame_path(template, f);
         written.push(path.clone());
         if a.resume && path.is_file() {

@@ -1,0 +1,236 @@
+//! Frame shards and mergeable sample batches.
+
+use assert_cmd::cargo::CommandCargoExt;
+use std::path::{Path, PathBuf};
+use std::process::Command;
+
+const SCENE: &str = r#"Scene(
+    render: (width: 32, height: 24, spp: 8, max_depth: 4, seed: 5),
+    camera: (position: (0.0, 1.0, 6.0), look_at: (0.0, 0.5, 0.0), fov_y: 40.0),
+    animation: (fps: 12, keyframes: [
+        (frame: 0, position: (0.0, 1.0, 6.0), look_at: (0.0, 0.5, 0.0)),
+        (frame: 9, position: (3.0, 2.0, 4.0), look_at: (0.0, 0.5, 0.0)),
+    ]),
+    environment: Constant(Rgb(0.4, 0.4, 0.4)),
+    entities: [
+        (name: "ball", shape: Sphere(center: (0.0, 0.5, 0.0), radius: 0.5), material: Diffuse(albedo: Rgb(0.6, 0.2, 0.2))),
+        (name: "floor", shape: Rect(center: (0.0, 0.0, 0.0), u: (5.0, 0.0, 0.0), v: (0.0, 0.0, -5.0)), material: Diffuse(albedo: Rgb(0.5, 0.5, 0.5))),
+    ],
+)"#;
+
+fn prism() -> Command {
+    Command::cargo_bin("prism").unwrap()
+}
+
+fn ok(c: &mut Command) -> String {
+    let out = c.output().unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    String::from_utf8_lossy(&out.stderr).to_string()
+}
+
+fn fails(c: &mut Command) -> String {
+    let out = c.output().unwrap();
+    assert!(!out.status.success());
+    let e = String::from_utf8_lossy(&out.stderr).to_string();
+    assert_eq!(e.trim_end().lines().count(), 1, "{e}");
+    e
+}
+
+fn setup() -> (tempfile::TempDir, PathBuf) {
+    let d = tempfile::tempdir().unwrap();
+    let scene = d.path().join("s.ron");
+    std::fs::write(&scene, SCENE).unwrap();
+    (d, scene)
+}
+
+fn names(dir: &Path) -> Vec<String> {
+    let mut v: Vec<String> = std::fs::read_dir(dir)
+        .map(|r| {
+            r.map(|e| e.unwrap().file_name().to_string_lossy().to_string())
+                .collect()
+        })
+        .unwrap_or_default();
+    v.sort();
+    v
+}
+
+#[test]
+fn shards_render_the_range_exactly_once() {
+    let (d, scene) = setup();
+    let s = scene.to_str().unwrap();
+    let all = d.path().join("all");
+    let sh = d.path().join("sharded");
+    ok(prism()
+        .args(["render", s, "--frames", "2..=8", "--quiet", "-o"])
+        .arg(all.join("f_##.png")));
+    for i in 0..3 {
+        ok(prism()
+            .args([
+                "render",
+                s,
+                "--frames",
+                "2..=8",
+                "--quiet",
+                "--shard",
+                &format!("{i}/3"),
+                "-o",
+            ])
+            .arg(sh.join("f_##.png")));
+    }
+    assert_eq!(names(&all), names(&sh));
+    assert_eq!(names(&all).len(), 7);
+    for n in names(&all) {
+        assert_eq!(
+            std::fs::read(all.join(&n)).unwrap(),
+            std::fs::read(sh.join(&n)).unwrap(),
+            "{n}"
+        );
+    }
+    // The index may come from the scheduler's environment.
+    let env = d.path().join("env");
+    ok(prism()
+        .args([
+            "render",
+            s,
+            "--frames",
+            "0..6",
+            "--quiet",
+            "--shard-from-env",
+            "PRISM_TEST_INDEX",
+            "--shard-count",
+            "4",
+            "-o",
+        ])
+        .arg(env.join("f_##.png"))
+        .env("PRISM_TEST_INDEX", "1"));
+    assert_eq!(names(&env), ["f_01.png", "f_05.png"]);
+    let e = fails(
+        prism()
+            .args([
+                "render",
+                s,
+                "--frames",
+                "0..6",
+                "--shard-from-env",
+                "PRISM_TEST_INDEX",
+                "--shard-count",
+                "4",
+                "-o",
+            ])
+            .arg(env.join("f_##.png"))
+            .env("PRISM_TEST_INDEX", "7"),
+    );
+    assert!(e.contains("outside 0..4"), "{e}");
+}
+
+#[test]
+fn a_rerun_shard_skips_finished_frames() {
+    let (d, scene) = setup();
+    let s = scene.to_str().unwrap();
+    let out = d.path().join("o");
+    let run = |extra: &[&str]| {
+        ok(prism()
+            .args(["render", s, "--frames", "0..8", "--shard", "1/2", "-o"])
+            .arg(out.join("f_##.png"))
+            .args(extra))
+    };
+    run(&["--quiet"]);
+    let before = std::fs::read(out.join("f_03.png")).unwrap();
+    std::fs::remove_file(out.join("f_05.png")).unwrap();
+    let log = run(&["--resume"]);
+    assert_eq!(log.matches("skipped").count(), 3, "{log}");
+    assert_eq!(
+        names(&out),
+        ["f_01.png", "f_03.png", "f_05.png", "f_07.png"]
+    );
+    assert_eq!(std::fs::read(out.join("f_03.png")).unwrap(), before);
+}
+
+fn exr(scene: &str, spp: u32, offset: u32, out: &Path, extra: &[&str]) {
+    ok(prism()
+        .args([
+            "render",
+            scene,
+            "--quiet",
+            "--spp",
+            &spp.to_string(),
+            "--sample-offset",
+            &offset.to_string(),
+            "-o",
+        ])
+        .arg(out)
+        .args(extra));
+}
+
+#[test]
+fn merged_halves_equal_the_whole_render() {
+    let (d, scene) = setup();
+    let s = scene.to_str().unwrap();
+    let p = |n: &str| d.path().join(n);
+    exr(s, 8, 0, &p("a.exr"), &[]);
+    exr(s, 4, 8, &p("b.exr"), &[]);
+    exr(s, 4, 12, &p("c.exr"), &[]);
+    exr(s, 16, 0, &p("whole.exr"), &[]);
+    ok(prism()
+        .args(["merge"])
+        .args([p("c.exr"), p("a.exr"), p("b.exr")])
+        .arg("-o")
+        .arg(p("m.exr")));
+    let (m, mm) = prism::film::read_image(&p("m.exr")).unwrap();
+    let (w, wm) = prism::film::read_image(&p("whole.exr")).unwrap();
+    let (mm, wm) = (mm.unwrap(), wm.unwrap());
+    assert_eq!(
+        (mm.spp, mm.sample_offset, mm.scene_hash),
+        (wm.spp, wm.sample_offset, wm.scene_hash)
+    );
+    // Not bit for bit: each part stores its mean as f32, so the merge differs from the single
+    // render by the rounding of those means (a few ulps), not by any sample.
+    for (a, b) in m.pixels.iter().zip(&w.pixels) {
+        for c in 0..3 {
+            assert!(
+                (a[c] - b[c]).abs() <= 4.0 * f32::EPSILON * b[c].abs().max(1e-3),
+                "{} vs {}",
+                a[c],
+                b[c]
+            );
+        }
+    }
+}
+
+#[test]
+fn merge_refuses_parts_that_do_not_belong_together() {
+    let (d, scene) = setup();
+    let s = scene.to_str().unwrap();
+    let p = |n: &str| d.path().join(n);
+    exr(s, 4, 0, &p("a.exr"), &[]);
+    exr(s, 4, 2, &p("overlap.exr"), &[]);
+    exr(s, 4, 8, &p("gap.exr"), &[]);
+    exr(s, 4, 4, &p("seed.exr"), &["--seed", "9"]);
+    exr(s, 4, 4, &p("small.exr"), &["--size", "16x12"]);
+    ok(prism()
+        .args(["render", s, "--quiet", "--spp", "4", "-o"])
+        .arg(p("a.png")));
+    let merge = |x: &str, y: &str| {
+        fails(
+            prism()
+                .arg("merge")
+                .arg(p(x))
+                .arg(p(y))
+                .arg("-o")
+                .arg(p("m.exr")),
+        )
+    };
+    assert!(merge("a.exr", "overlap.exr").contains("overlap"));
+    assert!(merge("a.exr", "gap.exr").contains("missing"));
+    assert!(merge("a.exr", "seed.exr").contains("different scenes"));
+    assert!(
+        merge("a.exr", "small.exr").contains("different scenes")
+            || merge("a.exr", "small.exr").contains("32x24")
+    );
+    assert!(merge("a.exr", "a.png").contains("header"));
+    assert!(!p("m.exr").exists());
+}
