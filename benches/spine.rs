@@ -158,5 +158,35 @@ fn integrator(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, kdtree, camera, integrator);
+/// One wavefront pass per effect set, forced on the Cornell box, so a regression in one
+/// effect's cost shows on its own.
+fn effects(c: &mut Criterion) {
+    use prism::systems::Effect;
+    let mut g = c.benchmark_group("effects");
+    g.sample_size(10);
+    let opts = RenderOptions {
+        sample_offset: 0,
+        spp: 2,
+        time_limit: None,
+        integrator: Integrator::Wavefront,
+    };
+    let sets: [(&str, &[Effect]); 4] = [
+        ("none", &[]),
+        ("lens", &[Effect::Lens]),
+        ("motion", &[Effect::Motion]),
+        ("lens_motion", &[Effect::Lens, Effect::Motion]),
+    ];
+    for (name, set) in sets {
+        let mut scene = cornell(48, 2);
+        for e in set {
+            scene.effects.force(*e).unwrap();
+        }
+        g.bench_function(format!("cornell_48x48_2spp_{name}"), |b| {
+            b.iter(|| render(&scene, &opts, &|_| {}).stats.samples)
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, kdtree, camera, integrator, effects);
 criterion_main!(benches);

@@ -32,6 +32,20 @@ pub enum Command {
     Info(InfoArgs),
     /// Print RMSE, relMSE and the maximum error between an image and a reference (B).
     Compare { a: PathBuf, b: PathBuf },
+    /// Measure error against a converged reference per second of render, for one or more
+    /// configurations; writes converge.csv, converge.png/.svg and summary.md into DIR.
+    Converge(ConvergeArgs),
+    /// Time per sample of each scene, and with each effect it does not need forced on.
+    Costs {
+        #[arg(required = true)]
+        scenes: Vec<PathBuf>,
+        #[arg(long, default_value_t = 4)]
+        spp: u32,
+        #[arg(long, default_value_t = 5)]
+        runs: usize,
+        #[arg(long, value_parser = parse_size)]
+        size: Option<(u32, u32)>,
+    },
     /// Combine EXR sample batches of one image, weighted by their sample counts.
     Merge {
         #[arg(required = true)]
@@ -106,6 +120,48 @@ pub struct RenderArgs {
 }
 
 #[derive(Args, Debug)]
+pub struct ConvergeArgs {
+    pub scene: PathBuf,
+    /// Output folder.
+    #[arg(short, long)]
+    pub output: PathBuf,
+    /// A converged reference image; default: render one (cached in the output folder).
+    #[arg(long)]
+    pub reference: Option<PathBuf>,
+    /// Samples per pixel of a reference prism renders.
+    #[arg(long, default_value_t = 1024)]
+    pub reference_spp: u32,
+    /// Seconds each configuration may spend on its ladder of sample counts.
+    #[arg(long, default_value_t = 10.0)]
+    pub budget: f64,
+    /// KEY=V1,V2,...: one curve per value (several --vary: every combination). Keys: spp,
+    /// max_depth, rr_depth, light_sampling, fresnel, wavelengths, sampler, force,
+    /// kd.intersect_cost, kd.traversal_cost, kd.empty_bonus, kd.max_leaf_prims, or any --set key.
+    #[arg(long, value_parser = parse_vary)]
+    pub vary: Vec<(String, Vec<String>)>,
+    #[arg(long = "set", value_parser = parse_key_value)]
+    pub set: Vec<(String, String)>,
+    /// Image size WxH for the study and its reference.
+    #[arg(long, value_parser = parse_size)]
+    pub size: Option<(u32, u32)>,
+    #[arg(short, long)]
+    pub quiet: bool,
+}
+
+fn parse_vary(s: &str) -> Result<(String, Vec<String>), String> {
+    let (k, v) = parse_key_value(s)?;
+    let vals: Vec<String> = v
+        .split(',')
+        .map(|x| x.trim().to_string())
+        .filter(|x| !x.is_empty())
+        .collect();
+    if vals.is_empty() {
+        return Err(format!("expected KEY=V1,V2,..., got '{s}'"));
+    }
+    Ok((k, vals))
+}
+
+#[derive(Args, Debug)]
 pub struct InfoArgs {
     pub scene: PathBuf,
     #[arg(long = "set", value_parser = parse_key_value)]
@@ -169,6 +225,56 @@ pub fn run(cli: Cli) -> Result<(), CliError> {
     match cli.command {
         Command::Render(a) => render(a),
         Command::Info(a) => info(a),
+        Command::Converge(a) => {
+            if !(a.budget.is_finite() && a.budget > 0.0) {
+                return Err(CliError(format!(
+                    "--budget must be a positive number of seconds, got {}",
+                    a.budget
+                )));
+            }
+            let mut set = a.set.clone();
+            if let Some((w, h)) = a.size {
+                set.push(("render.width".into(), w.to_string()));
+                set.push(("render.height".into(), h.to_string()));
+            }
+            // Check the scene and the overrides once, with located errors, before the study.
+            load_scene(&a.scene, &set, &[])?;
+            let r = crate::report::converge(&crate::report::ConvergeOptions {
+                scene: a.scene.clone(),
+                set,
+                reference: a.reference.clone(),
+                reference_spp: a.reference_spp.max(2),
+                budget: a.budget,
+                vary: a.vary.clone(),
+                out: a.output.clone(),
+                quiet: a.quiet,
+            })
+            .map_err(CliError)?;
+            if !a.quiet {
+                eprintln!(
+                    "wrote {}/converge.csv, converge.png, converge.svg, summary.md",
+                    a.output.display()
+                );
+            }
+            print!("{}", r.summary);
+            Ok(())
+        }
+        Command::Costs {
+            scenes,
+            spp,
+            runs,
+            size,
+        } => {
+            let mut set = Vec::new();
+            if let Some((w, h)) = size {
+                set.push(("render.width".to_string(), w.to_string()));
+                set.push(("render.height".to_string(), h.to_string()));
+            }
+            let t = crate::report::costs::effect_costs(&scenes, &set, spp.max(1), runs.max(1))
+                .map_err(CliError)?;
+            print!("{t}");
+            Ok(())
+        }
         Command::Merge { parts, output } => {
             let (spp, offset) = farm::merge(&parts, &output)?;
             eprintln!(

@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# Regenerates the figures of the README's "What accuracy costs" section into assets/accuracy/:
+# convergence studies of the shipped scenes and the table of effect costs.
+# Usage: scripts/accuracy.sh [BUDGET_SECONDS]   (default 20 per configuration)
+set -euo pipefail
+cd "$(dirname "$0")/.."
+budget=${1:-20}
+cargo build --release --quiet
+p=./target/release/prism
+out=assets/accuracy
+mkdir -p "$out"
+$p converge scenes/cornell.ron --size 128x128 --reference-spp 4096 --budget "$budget" \
+    --vary light_sampling=Nee,Path --vary max_depth=3,12 -o "$out/cornell" --quiet > /dev/null
+$p converge scenes/caustics.ron --size 128x128 --reference-spp 4096 --budget "$budget" \
+    --vary fresnel=Exact,Schlick -o "$out/caustics" --quiet > /dev/null
+$p costs scenes/cornell.ron scenes/caustics.ron scenes/motion_blur.ron scenes/earth_dof.ron \
+    --size 128x128 --spp 8 --runs 5 > "$out/effect_costs.md"
+
+
+echo "wrote $out"

@@ -1,0 +1,477 @@
+//! `prism converge`: error against a converged reference, per second of render, for one or
+//! more configurations of a scene.
+
+use crate::film::{self, Image, ImageMeta, PngOptions};
+use crate::integrator::{Integrator, RenderOptions, render};
+use crate::kdtree::KdParams;
+use crate::scene_file::{self, LoadedScene};
+use crate::systems::{self, Effect};
+use std::fmt::Write as _;
+use std::path::{Path, PathBuf};
+use std::time::Instant;
+
+/// One configuration: a name and the settings that differ from the scene's.
+#[derive(Clone, Debug)]
+pub struct Config {
+    pub name: String,
+    pub overrides: Vec<(String, String)>,
+    pub force: Vec<Effect>,
+    pub kd: KdParams,
+    /// Sample counts to render instead of the doubling ladder.
+    pub spp: Option<Vec<u32>>,
+}
+
+/// One rung of a configuration's ladder.
+#[derive(Clone, Debug)]
+pub struct Row {
+    pub config: String,
+    pub spp: u32,
+    pub seconds: f64,
+    pub rmse: f64,
+    pub relmse: f64,
+    pub ssim: f64,
+}
+
+pub struct ConvergeOptions {
+    pub scene: PathBuf,
+    pub set: Vec<(String, String)>,
+    pub reference: Option<PathBuf>,
+    pub reference_spp: u32,
+    /// Seconds each configuration may spend on its ladder.
+    pub budget: f64,
+    pub vary: Vec<(String, Vec<String>)>,
+    pub out: PathBuf,
+    pub quiet: bool,
+}
+
+pub struct ConvergeResult {
+    pub rows: Vec<Row>,
+    /// The reference's own estimated relMSE (from two independent halves), when prism
+    /// rendered it.
+    pub reference_relmse: Option<f64>,
+    pub summary: String,
+}
+
+/// Keys `--vary` understands besides every `--set` key.
+pub const VARY_ALIASES: &[(&str, &str)] = &[
+    ("max_depth", "render.max_depth"),
+    ("rr_depth", "render.integrator.rr_depth"),
+    ("light_sampling", "render.integrator.light_sampling"),
+    ("fresnel", "render.integrator.fresnel"),
+    ("wavelengths", "render.integrator.wavelengths"),
+    ("sampler", "render.integrator.sampler"),
+];
+
+fn apply_knob(c: &mut Config, key: &str, value: &str) -> Result<(), String> {
+    let num = |v: &str| -> Result<f32, String> {
+        v.parse::<f32>()
+            .map_err(|_| format!("--vary {key}: '{v}' is not a number"))
+    };
+    match key {
+        "spp" => {
+            let n: u32 = value
+                .parse()
+                .map_err(|_| format!("--vary spp: '{value}' is not a sample count"))?;
+            c.spp = Some(vec![n]);
+        }
+        "force" | "spectral" | "effect" => {
+            if !matches!(value, "none" | "auto") {
+                let e = Effect::parse(value)
+                    .ok_or_else(|| format!("--vary {key}: unknown effect '{value}'"))?;
+                c.force.push(e);
+            }
+        }
+        "kd.intersect_cost" => c.kd.intersect_cost = num(value)?,
+        "kd.traversal_cost" => c.kd.traversal_cost = num(value)?,
+        "kd.empty_bonus" => c.kd.empty_bonus = num(value)?,
+        "kd.max_leaf_prims" => c.kd.max_leaf_prims = num(value)? as u32,
+        _ => {
+            let full = VARY_ALIASES
+                .iter()
+                .find(|(a, _)| *a == key)
+                .map_or(key, |(_, f)| f);
+            c.overrides.push((full.to_string(), value.to_string()));
+        }
+    }
+    Ok(())
+}
+
+/// The configurations: the cartesian product of every `--vary` list (the scene as it is when
+/// there is none).
+pub fn configs(vary: &[(String, Vec<String>)]) -> Result<Vec<Config>, String> {
+    let mut out = vec![Config {
+        name: String::new(),
+        overrides: Vec::new(),
+        force: Vec::new(),
+        kd: KdParams::default(),
+        spp: None,
+    }];
+    for (key, values) in vary {
+        if values.is_empty() {
+            return Err(format!("--vary {key}: no values"));
+        }
+        let mut next = Vec::new();
+        for c in &out {
+            for v in values {
+                let mut c = c.clone();
+                apply_knob(&mut c, key, v)?;
+                if !c.name.is_empty() {
+                    c.name.push(' ');
+                }
+                write!(c.name, "{key}={v}").unwrap();
+                next.push(c);
+            }
+        }
+        out = next;
+    }
+    if out.len() > 24 {
+        return Err(format!(
+            "{} configurations: vary fewer knobs at once (at most 24)",
+            out.len()
+        ));
+    }
+    // Several `--vary spp=` values make one ladder, not one curve each.
+    let spp_only = vary.iter().all(|(k, _)| k == "spp") && !vary.is_empty();
+    if spp_only {
+        let ladder: Vec<u32> = out
+            .iter()
+            .filter_map(|c| c.spp.as_ref().map(|s| s[0]))
+            .collect();
+        return Ok(vec![Config {
+            name: "baseline".into(),
+            overrides: Vec::new(),
+            force: Vec::new(),
+            kd: KdParams::default(),
+            spp: Some(ladder),
+        }]);
+    }
+    if out.len() == 1 && out[0].name.is_empty() {
+        out[0].name = "baseline".into();
+    }
+    Ok(out)
+}
+
+fn fnv(bytes: &[u8], mut h: u64) -> u64 {
+    for &b in bytes {
+        h = (h ^ b as u64).wrapping_mul(0x0100_0000_01b3);
+    }
+    h
+}
+
+fn load(opts: &ConvergeOptions, extra: &[(String, String)]) -> Result<LoadedScene, String> {
+    let mut all = opts.set.clone();
+    all.extend_from_slice(extra);
+    scene_file::load(&opts.scene, &all).map_err(|e| e.to_string())
+}
+
+/// Renders `spp` samples from `offset` and returns the image and the seconds it took,
+/// preparation included.
+fn timed_render(
+    scene: &LoadedScene,
+    kd: &KdParams,
+    force: &[Effect],
+    spp: u32,
+    offset: u32,
+) -> Result<(Image, f64), String> {
+    let t0 = Instant::now();
+    let mut rs = systems::prepare(scene, kd);
+    for e in force {
+        rs.effects.force(*e)?;
+    }
+    let out = render(
+        &rs,
+        &RenderOptions {
+            sample_offset: offset,
+            spp,
+            time_limit: None,
+            integrator: Integrator::Wavefront,
+        },
+        &|_| {},
+    );
+    Ok((out.image(), t0.elapsed().as_secs_f64()))
+}
+
+/// The reference image: given, cached from an earlier run, or rendered now in two
+/// independent halves whose difference estimates its own error.
+fn reference(opts: &ConvergeOptions) -> Result<(Image, Option<f64>), String> {
+    if let Some(p) = &opts.reference {
+        let (img, _) = film::read_image(p).map_err(|e| e.to_string())?;
+        return Ok((img, None));
+    }
+    let scene = load(opts, &[])?;
+    let text = std::fs::read(&opts.scene)
+        .map_err(|e| format!("cannot read '{}': {e}", opts.scene.display()))?;
+    let mut h = fnv(&text, 0xcbf2_9ce4_8422_2325);
+    for (k, v) in &opts.set {
+        h = fnv(k.as_bytes(), fnv(v.as_bytes(), h));
+    }
+    h = fnv(&opts.reference_spp.to_le_bytes(), h);
+    let path = opts.out.join(format!("reference_{h:016x}.exr"));
+    let note = opts.out.join(format!("reference_{h:016x}.txt"));
+    if path.is_file() {
+        let (img, _) = film::read_image(&path).map_err(|e| e.to_string())?;
+        let est = std::fs::read_to_string(&note)
+            .ok()
+            .and_then(|s| s.trim().parse().ok());
+        if !opts.quiet {
+            eprintln!("reference: cached {}", path.display());
+        }
+        return Ok((img, est));
+    }
+    let half = (opts.reference_spp / 2).max(1);
+    if !opts.quiet {
+        eprintln!("reference: rendering {} spp in two halves ...", 2 * half);
+    }
+    let kd = KdParams::default();
+    let (a, _) = timed_render(&scene, &kd, &[], half, 0)?;
+    let (b, _) = timed_render(&scene, &kd, &[], half, half)?;
+    let mut img = a.clone();
+    let mut est = 0.0f64;
+    for ((p, pa), pb) in img.pixels.iter_mut().zip(&a.pixels).zip(&b.pixels) {
+        for c in 0..3 {
+            let r = 0.5 * (pa[c] as f64 + pb[c] as f64);
+            p[c] = r as f32;
+            // Var(mean of two halves) = Var(A − B) / 4.
+            est += (pa[c] as f64 - pb[c] as f64).powi(2) / 4.0 / (r * r + 0.01);
+        }
+    }
+    est /= (img.pixels.len() * 3) as f64;
+    let meta = ImageMeta {
+        spp: 2 * half,
+        sample_offset: 0,
+        scene_hash: scene.hash,
+    };
+    film::write_image(&path, &img, &meta, &PngOptions::default()).map_err(|e| e.to_string())?;
+    film::write_atomic(&note, format!("{est:e}\n").as_bytes()).map_err(|e| e.to_string())?;
+    Ok((img, Some(est)))
+}
+
+/// Runs the study and writes `converge.csv`, `converge.png`, `converge.svg` and `summary.md`
+/// into `opts.out`.
+pub fn converge(opts: &ConvergeOptions) -> Result<ConvergeResult, String> {
+    std::fs::create_dir_all(&opts.out)
+        .map_err(|e| format!("cannot create '{}': {e}", opts.out.display()))?;
+    let configs = configs(&opts.vary)?;
+    let (reference, ref_est) = reference(opts)?;
+    let mut rows = Vec::new();
+    for c in &configs {
+        let scene = load(opts, &c.overrides)?;
+        if (scene.render.width, scene.render.height) != (reference.width, reference.height) {
+            return Err(format!(
+                "the reference is {}x{} but configuration '{}' renders {}x{}",
+                reference.width, reference.height, c.name, scene.render.width, scene.render.height
+            ));
+        }
+        let ladder: Vec<u32> = match &c.spp {
+            Some(l) => l.clone(),
+            None => (0..20).map(|k| 1u32 << k).collect(),
+        };
+        let mut spent = 0.0;
+        let mut last: Option<(u32, f64)> = None;
+        for &spp in &ladder {
+            if c.spp.is_none() {
+                // Stop before a rung that would overrun the budget (time grows with spp).
+                if let Some((s0, t0)) = last
+                    && spent + t0 * spp as f64 / s0 as f64 > opts.budget
+                {
+                    break;
+                }
+                if spp > opts.reference_spp / 4 {
+                    break;
+                }
+            }
+            let (img, secs) = timed_render(&scene, &c.kd, &c.force, spp, 0)?;
+            spent += secs;
+            last = Some((spp, secs));
+            let m = film::compare(&img, &reference).map_err(|e| e.to_string())?;
+            let row = Row {
+                config: c.name.clone(),
+                spp,
+                seconds: secs,
+                rmse: m.rmse,
+                relmse: m.relmse,
+                ssim: super::ssim::ssim(&img, &reference),
+            };
+            if !opts.quiet {
+                eprintln!(
+                    "{}: {} spp, {:.3} s, relMSE {:.3e}",
+                    row.config, row.spp, row.seconds, row.relmse
+                );
+            }
+            rows.push(row);
+        }
+    }
+    let mut csv = String::from("config,spp,seconds,rmse,relmse,ssim\n");
+    for r in &rows {
+        writeln!(
+            csv,
+            "{},{},{:.6},{:.6e},{:.6e},{:.6}",
+            csv_field(&r.config),
+            r.spp,
+            r.seconds,
+            r.rmse,
+            r.relmse,
+            r.ssim
+        )
+        .unwrap();
+    }
+    film::write_atomic(&opts.out.join("converge.csv"), csv.as_bytes())
+        .map_err(|e| e.to_string())?;
+    let names: Vec<String> = configs.iter().map(|c| c.name.clone()).collect();
+    super::plot::plot(
+        &rows,
+        &names,
+        &opts.out.join("converge.png"),
+        &opts.out.join("converge.svg"),
+    )?;
+    let summary = summary(&opts.scene, &rows, &names, ref_est);
+    film::write_atomic(&opts.out.join("summary.md"), summary.as_bytes())
+        .map_err(|e| e.to_string())?;
+    Ok(ConvergeResult {
+        rows,
+        reference_relmse: ref_est,
+        summary,
+    })
+}
+
+fn csv_field(s: &str) -> String {
+    if s.contains([',', '"']) {
+        format!("\"{}\"", s.replace('"', "\"\""))
+    } else {
+        s.to_string()
+    }
+}
+
+/// Least-squares slope and intercept of log10(relMSE) against log10(seconds).
+pub fn fit(points: &[(f64, f64)]) -> Option<(f64, f64)> {
+    let p: Vec<(f64, f64)> = points
+        .iter()
+        .filter(|(t, e)| *t > 0.0 && *e > 0.0)
+        .map(|(t, e)| (t.log10(), e.log10()))
+        .collect();
+    if p.len() < 2 {
+        return None;
+    }
+    let n = p.len() as f64;
+    let (sx, sy) = p.iter().fold((0.0, 0.0), |a, q| (a.0 + q.0, a.1 + q.1));
+    let (mx, my) = (sx / n, sy / n);
+    let (mut sxx, mut sxy) = (0.0, 0.0);
+    for (x, y) in &p {
+        sxx += (x - mx) * (x - mx);
+        sxy += (x - mx) * (y - my);
+    }
+    if sxx <= 0.0 {
+        return None;
+    }
+    let slope = sxy / sxx;
+    Some((slope, my - slope * mx))
+}
+
+/// Seconds to reach `target` relMSE: interpolated between the rungs that straddle it, or
+/// extrapolated from the fit (marked) when the ladder stopped above it.
+fn time_to(points: &[(f64, f64)], target: f64) -> String {
+    for w in points.windows(2) {
+        let ((t0, e0), (t1, e1)) = (w[0], w[1]);
+        if e0 > target && e1 <= target && t0 > 0.0 && e1 > 0.0 {
+            let f = (target.log10() - e0.log10()) / (e1.log10() - e0.log10());
+            return format!(
+                "{:.3} s",
+                10f64.powf(t0.log10() + f * (t1.log10() - t0.log10()))
+            );
+        }
+    }
+    if let Some(&(t, e)) = points.first()
+        && e <= target
+    {
+        return format!("≤ {t:.3} s");
+    }
+    match fit(points) {
+        Some((slope, b)) if slope < -0.05 => {
+            format!(
+                "~{:.3} s (extrapolated)",
+                10f64.powf((target.log10() - b) / slope)
+            )
+        }
+        _ => "not reached (error floor)".into(),
+    }
+}
+
+fn summary(scene: &Path, rows: &[Row], names: &[String], ref_est: Option<f64>) -> String {
+    let mut s = format!("# Convergence of `{}`\n\n", scene.display());
+    match ref_est {
+        Some(e) => writeln!(
+            s,
+            "Reference: rendered by prism in two independent halves; its own estimated relMSE is {e:.2e}, so errors within a few times that are reference noise.\n"
+        )
+        .unwrap(),
+        None => writeln!(s, "Reference: supplied with `--reference`.\n").unwrap(),
+    }
+    s.push_str("| configuration | rungs | slope (log relMSE / log s) | time to 1 % relMSE | time to 0.1 % relMSE | last relMSE | note |\n");
+    s.push_str("|---|---|---|---|---|---|---|\n");
+    for name in names {
+        let pts: Vec<(f64, f64)> = rows
+            .iter()
+            .filter(|r| &r.config == name)
+            .map(|r| (r.seconds, r.relmse))
+            .collect();
+        let slope = fit(&pts).map_or("–".into(), |(k, _)| format!("{k:.2}"));
+        // Unbiased Monte Carlo error falls as 1/time (slope −1); a bias flattens the tail.
+        let tail = if pts.len() >= 3 {
+            fit(&pts[pts.len() - 3..])
+        } else {
+            None
+        };
+        let floor = match tail {
+            Some((k, _)) if k > -0.3 => pts.last().map(|p| p.1),
+            _ => None,
+        };
+        let note = floor.map_or(String::new(), |f| format!("error floor ≈ {f:.2e}: bias"));
+        // Past a floor, extrapolating the fit would promise what the bias forbids.
+        let reach = |target: f64| match floor {
+            Some(f) if f > target => format!("not reached (floor {f:.1e})"),
+            _ => time_to(&pts, target),
+        };
+        writeln!(
+            s,
+            "| {} | {} | {} | {} | {} | {} | {} |",
+            name,
+            pts.len(),
+            slope,
+            reach(0.01),
+            reach(0.001),
+            pts.last().map_or("–".into(), |p| format!("{:.2e}", p.1)),
+            note
+        )
+        .unwrap();
+    }
+    s.push_str("\nrelMSE = mean((x − r)² / (r² + 0.01)) over pixels and channels; seconds include scene preparation.\n");
+    s
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fit_recovers_a_power_law() {
+        let pts: Vec<(f64, f64)> = (0..6).map(|k| (2f64.powi(k), 0.5 / 2f64.powi(k))).collect();
+        let (slope, b) = fit(&pts).unwrap();
+        assert!((slope + 1.0).abs() < 1e-12 && (b - 0.5f64.log10()).abs() < 1e-12);
+        assert_eq!(time_to(&pts, 0.1), "5.000 s");
+    }
+
+    #[test]
+    fn vary_builds_the_product() {
+        let c = configs(&[
+            ("fresnel".into(), vec!["Exact".into(), "Schlick".into()]),
+            ("max_depth".into(), vec!["2".into(), "12".into()]),
+        ])
+        .unwrap();
+        assert_eq!(c.len(), 4);
+        assert_eq!(c[1].name, "fresnel=Exact max_depth=12");
+        assert_eq!(c[1].overrides[1], ("render.max_depth".into(), "12".into()));
+        let l = configs(&[("spp".into(), vec!["1".into(), "4".into()])]).unwrap();
+        assert_eq!(l.len(), 1);
+        assert_eq!(l[0].spp, Some(vec![1, 4]));
+    }
+}
