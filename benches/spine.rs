@@ -188,5 +188,69 @@ fn effects(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, kdtree, camera, integrator, effects);
+/// Texture lookups, and a pass over the textures scene against the same scene untextured.
+fn textures(c: &mut Criterion) {
+    let mut g = c.benchmark_group("textures");
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let mut cache = prism::texture::TextureCache::default();
+    let earth = cache
+        .get(
+            &dir.join("assets/earth.jpg"),
+            prism::texture::ColorSpace::Srgb,
+        )
+        .unwrap();
+    let s = Sampler::new(SamplerKind::Independent, 7);
+    let uvs: Vec<Vec2> = (0..4096u32).map(|i| s.get_2d(i, 0, 0)).collect();
+    g.bench_function("bilinear_earth_4096", |b| {
+        b.iter(|| {
+            uvs.iter()
+                .map(|uv| earth.bilinear(*uv, prism::texture::Wrap::Repeat).x)
+                .sum::<f32>()
+        })
+    });
+    let bricks = prism::texture::AlbedoTexture::Bricks(prism::texture::Bricks {
+        brick: glam::Vec3::new(0.5, 0.15, 0.1),
+        mortar: glam::Vec3::splat(0.8),
+        size: Vec2::new(0.4, 0.2),
+        joint: 0.02,
+    });
+    g.bench_function("bricks_albedo_and_height_4096", |b| {
+        b.iter(|| {
+            uvs.iter()
+                .map(|uv| bricks.eval(*uv).x + bricks.height(*uv))
+                .sum::<f32>()
+        })
+    });
+    g.sample_size(10);
+    let text = std::fs::read_to_string(dir.join("scenes/textures.ron")).unwrap();
+    let plain: String = text
+        .lines()
+        .filter(|l| !l.contains("texture:") && !l.trim_start().starts_with("normal_map:"))
+        .collect::<Vec<_>>()
+        .join("\n")
+        .replace(
+            "material: Diffuse(albedo: Rgb(1.0, 1.0, 1.0)),",
+            "material: Diffuse(albedo: Rgb(1.0, 1.0, 1.0))),",
+        );
+    for (name, t) in [("textured", &text), ("untextured", &plain)] {
+        let o = vec![
+            ("render.width".to_string(), "64".to_string()),
+            ("render.height".to_string(), "48".to_string()),
+        ];
+        let loaded = prism::scene_file::load_str(t, &dir.join("scenes/textures.ron"), &o).unwrap();
+        let scene = prepare(&loaded, &KdParams::default());
+        let opts = RenderOptions {
+            sample_offset: 0,
+            spp: 4,
+            time_limit: None,
+            integrator: Integrator::Wavefront,
+        };
+        g.bench_function(format!("pass_{name}_64x48_4spp"), |b| {
+            b.iter(|| render(&scene, &opts, &|_| {}).stats.samples)
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, kdtree, camera, integrator, effects, textures);
 criterion_main!(benches);

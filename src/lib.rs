@@ -16,3 +16,4 @@ pub mod report;
 pub mod sampling;
 pub mod scene_file;
 pub mod systems;
+pub mod texture;

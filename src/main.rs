@@ -15,6 +15,8 @@ fn main() -> ExitCode {
             .map(|l| format!(" at {}:{}", l.file(), l.line()))
             .unwrap_or_default();
         eprintln!("error: internal error: {msg}{at}");
+        // Other worker threads would report the same failure again: stop at the first.
+        std::process::exit(101);
     }));
     let cli = match prism::cli::Cli::try_parse() {
         Ok(c) => c,

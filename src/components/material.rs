@@ -29,6 +29,24 @@ pub enum Material {
 }
 
 impl Material {
+    /// The material with its colour multiplied by a texture's albedo: Diffuse albedo, Mirror
+    /// tint, Light emission; a Dielectric has no colour to modulate.
+    #[inline]
+    pub fn modulated(self, a: Vec3) -> Material {
+        match self {
+            Material::Diffuse { albedo } => Material::Diffuse { albedo: albedo * a },
+            Material::Mirror { tint } => Material::Mirror { tint: tint * a },
+            Material::Light {
+                emission,
+                two_sided,
+            } => Material::Light {
+                emission: emission * a,
+                two_sided,
+            },
+            m @ Material::Dielectric { .. } => m,
+        }
+    }
+
     pub fn is_emissive(&self) -> bool {
         matches!(self, Material::Light { emission, .. } if emission.max_element() > 0.0)
     }

@@ -4,11 +4,13 @@ pub mod camera;
 pub mod material;
 pub mod motion;
 pub mod shape;
+pub mod texture;
 
 pub use camera::Camera;
 pub use material::Material;
 pub use motion::Motion;
 pub use shape::Shape;
+pub use texture::Texture;
 
 use glam::Affine3A;
 

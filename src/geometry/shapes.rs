@@ -12,6 +12,8 @@ pub struct SurfacePoint {
     pub p: Vec3,
     /// Unit geometric normal: outward for closed shapes, `normalize(u × v)` for planar ones.
     pub n: Vec3,
+    /// Unit shading normal on the same side as `n` (interpolated on meshes; `n` elsewhere).
+    pub ns: Vec3,
     /// Whether the ray arrived from the side `n` points to. Decided from the intersection's
     /// topology (origin outside a closed shape, sign of the plane crossing), not from the sign
     /// of a dot product that rounding can flip at grazing angles.
@@ -23,6 +25,12 @@ impl SurfacePoint {
     #[inline]
     pub fn facing(&self) -> Vec3 {
         if self.front { self.n } else { -self.n }
+    }
+
+    /// The shading normal on the side the ray came from.
+    #[inline]
+    pub fn shading_facing(&self) -> Vec3 {
+        if self.front { self.ns } else { -self.ns }
     }
 }
 
@@ -101,6 +109,7 @@ impl Sphere {
         SurfacePoint {
             p: self.center + n * self.radius,
             n,
+            ns: n,
             front,
         }
     }
@@ -218,11 +227,19 @@ impl Planar {
         inside.then_some((t, a, b))
     }
 
+    /// (α, β) of a point in the plane.
+    #[inline]
+    pub fn coords(&self, p: Vec3) -> (f32, f32) {
+        let rel = p - self.center;
+        (self.w.dot(rel.cross(self.v)), self.w.dot(self.u.cross(rel)))
+    }
+
     #[inline]
     pub fn surface(&self, ray: &Ray, a: f32, b: f32) -> SurfacePoint {
         SurfacePoint {
             p: self.center + a * self.u + b * self.v,
             n: self.n,
+            ns: self.n,
             front: ray.d.dot(self.n) < 0.0,
         }
     }
@@ -321,6 +338,51 @@ impl OrientedBox {
         }
     }
 
+    /// Planar UVs on the face that was hit, over [0, 1]², with world-space derivatives.
+    pub fn uv_frame(&self, ray: &Ray, t: f32) -> (glam::Vec2, Vec3, Vec3) {
+        let r = self.object_ray(ray);
+        let p = r.at(t);
+        let (axis, _, _) = self.face(p);
+        // The two axes spanning the face, ordered so (u, v) is right-handed with the face's
+        // outward normal on the +side faces.
+        let (a, b) = match axis {
+            0 => (2, 1),
+            1 => (0, 2),
+            _ => (0, 1),
+        };
+        let size = self.max - self.min;
+        let uv = glam::Vec2::new(
+            (p[a] - self.min[a]) / size[a],
+            (p[b] - self.min[b]) / size[b],
+        );
+        let mut ea = Vec3::ZERO;
+        ea[a] = size[a];
+        let mut eb = Vec3::ZERO;
+        eb[b] = size[b];
+        (
+            uv,
+            self.to_world.transform_vector3(ea),
+            self.to_world.transform_vector3(eb),
+        )
+    }
+
+    /// The face nearest to object-space point `p`: (axis, plane coordinate, sign).
+    fn face(&self, p: Vec3) -> (usize, f32, f32) {
+        let size = (self.max - self.min).max(Vec3::splat(f32::MIN_POSITIVE));
+        let mut best = (f32::INFINITY, 0usize, 0.0f32, 1.0f32);
+        for a in 0..3 {
+            let dmin = (p[a] - self.min[a]).abs() / size[a];
+            let dmax = (p[a] - self.max[a]).abs() / size[a];
+            if dmin < best.0 {
+                best = (dmin, a, self.min[a], -1.0);
+            }
+            if dmax < best.0 {
+                best = (dmax, a, self.max[a], 1.0);
+            }
+        }
+        (best.1, best.2, best.3)
+    }
+
     pub fn surface(&self, ray: &Ray, t: f32, front: bool) -> SurfacePoint {
         let r = self.object_ray(ray);
         let mut p = r.at(t);
@@ -343,9 +405,11 @@ impl OrientedBox {
         p = p.clamp(self.min, self.max);
         let mut n_obj = Vec3::ZERO;
         n_obj[axis] = sign;
+        let n = (self.normal_matrix * n_obj).normalize();
         SurfacePoint {
             p: self.to_world.transform_point3(p),
-            n: (self.normal_matrix * n_obj).normalize(),
+            n,
+            ns: n,
             front,
         }
     }

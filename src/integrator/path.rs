@@ -32,6 +32,9 @@ pub struct Ctx<'a> {
     pub nee: bool,
     pub schlick: bool,
     pub lens: bool,
+    /// TEXTURES and NORMAL_MAPS: read once per render, never per ray from the world.
+    pub textures: bool,
+    pub normal_maps: bool,
 }
 
 impl<'a> Ctx<'a> {
@@ -54,6 +57,8 @@ impl<'a> Ctx<'a> {
             nee: s.light_sampling == LightSampling::Nee && !scene.lights.is_empty(),
             schlick: s.fresnel == Fresnel::Schlick,
             lens,
+            textures: scene.effects.has(crate::systems::Effect::Textures),
+            normal_maps: scene.effects.has(crate::systems::Effect::NormalMaps),
         }
     }
 }
@@ -171,11 +176,10 @@ pub fn lens_point(u: Vec2, blades: u32) -> Vec2 {
     p0 * b.x + p1 * b.y
 }
 
-/// Mirror reflection kept on the side of `n`: at grazing angles rounding can leave `wo` a
-/// hair below the surface, and the reflected ray must still leave on the side it is spawned.
+/// A reflected direction kept on the side of `n`: at grazing angles (or about a tilted shading
+/// normal) it can point a hair below the surface, and it must leave on the side it is spawned.
 #[inline]
-fn reflect_above(wo: Vec3, n: Vec3) -> Vec3 {
-    let r = reflect(wo, n);
+fn reflect_above(r: Vec3, n: Vec3) -> Vec3 {
     let c = r.dot(n);
     if c >= 0.0 {
         r
@@ -222,8 +226,24 @@ pub fn shade<const MOTION: bool>(
         return None;
     };
     let prims = &scene.prims;
-    let sp = prims.surface_at::<MOTION>(&s.ray, &hit, s.time);
-    let material = prims.materials[prims.material[hit.prim as usize] as usize];
+    let mut sp = prims.surface_at::<MOTION>(&s.ray, &hit, s.time);
+    let mut material = prims.materials[prims.material[hit.prim as usize] as usize];
+    if (ctx.textures || ctx.normal_maps)
+        && let Some(tex) = prims.texture_of(hit.prim)
+    {
+        let (uv, dpdu, dpdv) = prims.uv_frame::<MOTION>(&s.ray, &hit, &sp, s.time);
+        if ctx.textures
+            && let Some(a) = tex.albedo(uv)
+        {
+            material = material.modulated(a);
+        }
+        if ctx.normal_maps && tex.normal_map.is_some() {
+            // As pbrt does: the perturbed normal is turned to the geometric normal's side;
+            // directions it would send below the geometric surface are absorbed in scattering.
+            let ns = tex.shading_normal(uv, sp.ns, dpdu, dpdv);
+            sp.ns = if ns.dot(sp.n) < 0.0 { -ns } else { ns };
+        }
+    }
     if let Material::Light { .. } = material {
         let le = emitted(&material, sp.n, wo);
         if le != Vec3::ZERO {
@@ -248,17 +268,22 @@ pub fn shade<const MOTION: bool>(
     let dim = DIM_BOUNCE + s.depth * DIMS_PER_BOUNCE;
     let (pixel, index) = (s.pixel, s.sample);
     s.depth += 1;
-    // Surfaces scatter on both sides: work in the frame facing the incoming ray.
+    // Surfaces scatter on both sides: work in the frame facing the incoming ray. `nf` (the
+    // geometric normal) decides which side a direction is on, so light never leaks through a
+    // surface; `nsf` (the shading normal) shapes the scattering.
     let nf = sp.facing();
+    let nsf = sp.shading_facing();
     let mut shadow = None;
     match material {
         Material::Diffuse { albedo } => {
             if ctx.nee {
                 let u_sel = ctx.sampler.get_1d(pixel, index, dim);
                 let u_l = ctx.sampler.get_2d(pixel, index, dim + 1);
-                if let Some(ls) = lights.sample::<MOTION>(prims, sp.p, u_sel, u_l, s.time) {
-                    let cos = ls.wi.dot(nf);
-                    if cos > 0.0 {
+                if let Some(ls) =
+                    lights.sample::<MOTION>(prims, sp.p, u_sel, u_l, s.time, ctx.textures)
+                {
+                    let cos = ls.wi.dot(nsf);
+                    if cos > 0.0 && ls.wi.dot(nf) > 0.0 {
                         let bsdf_pdf = cos * std::f32::consts::FRAC_1_PI;
                         let f = albedo * std::f32::consts::FRAC_1_PI * cos;
                         let w = power_heuristic(ls.pdf, bsdf_pdf);
@@ -281,8 +306,14 @@ pub fn shade<const MOTION: bool>(
             }
             let u = ctx.sampler.get_2d(pixel, index, dim + 4);
             let local = sampling::square_to_cosine_hemisphere(u);
-            let (t, b) = sampling::coordinate_system(nf);
-            let wi = (t * local.x + b * local.y + nf * local.z).normalize();
+            let (t, b) = sampling::coordinate_system(nsf);
+            let wi = (t * local.x + b * local.y + nsf * local.z).normalize();
+            if wi.dot(nf) <= 0.0 {
+                // Sampled around a tilted shading normal into the geometric back side: the
+                // surface absorbs it rather than letting light through.
+                s.alive = false;
+                return shadow;
+            }
             s.beta *= albedo;
             s.prev_pdf = sampling::cosine_hemisphere_pdf(local.z);
             s.specular = false;
@@ -291,12 +322,15 @@ pub fn shade<const MOTION: bool>(
         Material::Mirror { tint } => {
             s.beta *= tint;
             s.specular = true;
-            s.ray = Ray::new(offset_ray_origin(sp.p, nf), reflect_above(wo, nf));
+            s.ray = Ray::new(
+                offset_ray_origin(sp.p, nf),
+                reflect_above(reflect(wo, nsf), nf),
+            );
         }
         Material::Dielectric { ior } => {
             // The geometric normal points out of a closed shape: entering on its front.
             let eta = if sp.front { ior } else { 1.0 / ior };
-            let cos_i = wo.dot(nf).max(0.0);
+            let cos_i = wo.dot(nsf).max(0.0);
             let r = if ctx.schlick {
                 fresnel_schlick(cos_i, eta)
             } else {
@@ -304,7 +338,7 @@ pub fn shade<const MOTION: bool>(
             };
             let u = ctx.sampler.get_1d(pixel, index, dim + 3);
             s.specular = true;
-            match refract(wo, nf, eta) {
+            match refract(wo, nsf, eta) {
                 Some(wt) if u >= r => {
                     // Radiance is compressed by 1/η² crossing into a denser medium.
                     s.beta /= eta * eta;
@@ -312,7 +346,10 @@ pub fn shade<const MOTION: bool>(
                     s.ray = Ray::new(offset_ray_origin(sp.p, -nf), below(wt, nf));
                 }
                 _ => {
-                    s.ray = Ray::new(offset_ray_origin(sp.p, nf), reflect_above(wo, nf));
+                    s.ray = Ray::new(
+                        offset_ray_origin(sp.p, nf),
+                        reflect_above(reflect(wo, nsf), nf),
+                    );
                 }
             }
         }

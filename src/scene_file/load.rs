@@ -265,6 +265,9 @@ fn build_world(scene: schema::Scene, path: &Path, hash: u64) -> Result<LoadedSce
     };
 
     let mut world = hecs::World::new();
+    // One cache per scene: an image used by several entities is decoded once.
+    let mut textures = crate::texture::TextureCache::default();
+    let scene_dir = path.parent().unwrap_or(Path::new("."));
     for (i, e) in scene.entities.iter().enumerate() {
         let name = e.name.clone().unwrap_or_else(|| format!("#{i}"));
         let err = |field: &'static str, message: String| SceneError::Entity {
@@ -337,7 +340,19 @@ fn build_world(scene: schema::Scene, path: &Path, hash: u64) -> Result<LoadedSce
                 }
             }
         };
+        let texture = match &e.texture {
+            Some(spec) => Some(
+                spec.build(scene_dir, &mut textures)
+                    .map_err(|te| err("texture", te.to_string()))?,
+            ),
+            None => None,
+        };
         let entity = world.spawn((Name(name), shape, transform, material));
+        if let Some(t) = texture {
+            world
+                .insert_one(entity, t)
+                .expect("entity was just spawned");
+        }
         if let Some(m) = &e.motion {
             let motion = Motion {
                 velocity: m.velocity.map_or(glam::Vec3::ZERO, |v| v.vec()),

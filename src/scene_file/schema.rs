@@ -281,7 +281,7 @@ pub struct Entity {
     #[serde(default)]
     pub material: Option<Material>,
     #[serde(default)]
-    pub texture: Option<NotYetTexture>,
+    pub texture: Option<crate::texture::TextureSpec>,
     #[serde(default)]
     pub motion: Option<Motion>,
     #[serde(default)]
@@ -681,6 +681,5 @@ macro_rules! not_yet {
     };
 }
 
-not_yet!(NotYetTexture, "texture", "textures and normal maps");
 not_yet!(NotYetMedium, "medium", "participating media");
 not_yet!(NotYetLight, "light", "point and spot lights");

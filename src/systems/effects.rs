@@ -1,7 +1,7 @@
 //! `detect_effects`: which optional parts of light transport a scene needs.
 
 use crate::components::camera::CameraPath;
-use crate::components::{Camera, Motion, Name};
+use crate::components::{Camera, Motion, Name, Texture};
 use std::fmt;
 
 /// One optional effect of the renderer.
@@ -45,7 +45,10 @@ impl Effect {
 
     /// Whether this build can simulate the effect at all.
     pub fn implemented(self) -> bool {
-        matches!(self, Effect::Lens | Effect::Motion)
+        matches!(
+            self,
+            Effect::Lens | Effect::Motion | Effect::Textures | Effect::NormalMaps
+        )
     }
 }
 
@@ -176,7 +179,40 @@ pub fn detect_effects(
         "no dispersive IOR and no spectral emitter",
     );
     fx.set(Effect::Media, false, "no Medium component");
-    fx.set(Effect::Textures, false, "no Texture component");
-    fx.set(Effect::NormalMaps, false, "no normal map");
+    let named = |f: &dyn Fn(&Texture) -> bool| -> Vec<String> {
+        world
+            .query::<(&Name, &Texture)>()
+            .iter()
+            .filter(|(_, t)| f(t))
+            .map(|(n, _)| format!("\"{}\"", n.0))
+            .collect()
+    };
+    let list = |v: &[String]| {
+        if v.len() > 3 {
+            format!("{} and {} more", v[..3].join(", "), v.len() - 3)
+        } else {
+            v.join(", ")
+        }
+    };
+    let albedo = named(&|t| t.albedo.is_some());
+    if albedo.is_empty() {
+        fx.set(Effect::Textures, false, "no texture with an albedo");
+    } else {
+        fx.set(
+            Effect::Textures,
+            true,
+            format!("albedo texture on entity {}", list(&albedo)),
+        );
+    }
+    let normals = named(&|t| t.normal_map.is_some());
+    if normals.is_empty() {
+        fx.set(Effect::NormalMaps, false, "no normal map");
+    } else {
+        fx.set(
+            Effect::NormalMaps,
+            true,
+            format!("normal map on entity {}", list(&normals)),
+        );
+    }
     fx
 }

@@ -48,6 +48,7 @@ impl Lights {
         u_select: f32,
         u: Vec2,
         time: f32,
+        textures: bool,
     ) -> Option<LightSample> {
         if self.lights.is_empty() {
             return None;
@@ -79,8 +80,14 @@ impl Lights {
                 }
                 let d = s.p - p;
                 let wi = d.normalize_or_zero();
-                let m = &prims.materials[prims.material[prim as usize] as usize];
-                let radiance = emitted(m, s.n, -wi);
+                let mut m = prims.materials[prims.material[prim as usize] as usize];
+                if textures && let Some(t) = prims.texture_of(prim) {
+                    let q = motion.map_or(s.p, |mo| mo.point_to_rest(s.p, time));
+                    if let Some(a) = t.albedo(prims.uv_at(prim, q)) {
+                        m = m.modulated(a);
+                    }
+                }
+                let radiance = emitted(&m, s.n, -wi);
                 (wi != Vec3::ZERO && radiance != Vec3::ZERO).then_some(LightSample {
                     wi,
                     point: Some((s.p, s.n)),

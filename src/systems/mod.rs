@@ -132,7 +132,13 @@ impl RenderScene {
         let mut best = None;
         self.accel.closest_hit(ray, t_max, |prim, t_max| {
             let (t, u, v) = self.prims.intersect_at::<MOTION>(prim, ray, t_max, time)?;
-            best = Some(Hit { t, prim, u, v });
+            best = Some(Hit {
+                t,
+                prim,
+                sub: 0,
+                u,
+                v,
+            });
             Some(t)
         })?;
         best

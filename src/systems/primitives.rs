@@ -1,10 +1,10 @@
 //! `gather_primitives`: flattens the world's shapes into per-kind arrays for the hot loop,
 //! keeping each primitive's entity for messages and statistics.
 
-use crate::components::{Material, Motion, Name, Shape, Transform};
+use crate::components::{Material, Motion, Name, Shape, Texture, Transform};
 use crate::geometry::{Aabb, OrientedBox, Planar, Ray, RigidMotion, Sphere, SurfacePoint};
 use crate::kdtree::KdPrimitives;
-use glam::Vec3;
+use glam::{Quat, Vec2, Vec3};
 
 /// The closed list of primitive kinds; the hot loop matches on it once per test.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -21,12 +21,15 @@ pub enum PrimKind {
 pub struct Hit {
     pub t: f32,
     pub prim: u32,
+    /// The part of the primitive that was hit (a mesh's triangle).
+    pub sub: u32,
     pub u: f32,
     pub v: f32,
 }
 
 pub const NO_LIGHT: u32 = u32::MAX;
 pub const NO_MOTION: u32 = u32::MAX;
+pub const NO_TEXTURE: u32 = u32::MAX;
 
 /// Structure-of-arrays primitive store. Index `i` addresses `kind`, `local`, `material`,
 /// `light` and `entity`; `local[i]` indexes the array of its kind.
@@ -43,7 +46,12 @@ pub struct Primitives {
     pub motions: Vec<RigidMotion>,
     /// The time interval the kd-tree's bounds must cover (frames).
     pub sweep: (f32, f32),
+    /// Index into `textures`, else `NO_TEXTURE`.
+    pub texture: Vec<u32>,
+    pub textures: Vec<Texture>,
     pub spheres: Vec<Sphere>,
+    /// Each sphere's rotation: its UVs turn with it (a globe's longitude).
+    pub sphere_rotation: Vec<Quat>,
     pub planars: Vec<Planar>,
     pub boxes: Vec<OrientedBox>,
     pub materials: Vec<Material>,
@@ -112,6 +120,7 @@ impl Primitives {
             return SurfacePoint {
                 p: m.point_to_world(sp.p, time),
                 n: m.vector_to_world(sp.n, time),
+                ns: m.vector_to_world(sp.ns, time),
                 front: sp.front,
             };
         }
@@ -147,6 +156,90 @@ impl Primitives {
         }
     }
 
+    /// Surface coordinates and their derivatives at a hit (TEXTURES and NORMAL_MAPS only):
+    /// `(uv, ∂p/∂u, ∂p/∂v)` in world space. `sp` is the hit's surface point.
+    pub fn uv_frame<const MOTION: bool>(
+        &self,
+        ray: &Ray,
+        hit: &Hit,
+        sp: &SurfacePoint,
+        time: f32,
+    ) -> (Vec2, Vec3, Vec3) {
+        let motion = if MOTION {
+            self.motion_of(hit.prim)
+        } else {
+            None
+        };
+        let l = self.local[hit.prim as usize] as usize;
+        let (p_rest, ray_rest) = match motion {
+            Some(m) => (m.point_to_rest(sp.p, time), m.ray_to_rest(ray, time)),
+            None => (sp.p, *ray),
+        };
+        let (uv, dpdu, dpdv) = match self.kind[hit.prim as usize] {
+            PrimKind::Sphere => {
+                let s = &self.spheres[l];
+                let rot = self.sphere_rotation[l];
+                let d = (rot.inverse() * (p_rest - s.center)).normalize_or(Vec3::Y);
+                let phi = d.x.atan2(d.z);
+                let theta = d.y.clamp(-1.0, 1.0).asin();
+                let uv = Vec2::new(
+                    0.5 + phi * std::f32::consts::FRAC_1_PI * 0.5,
+                    0.5 + theta * std::f32::consts::FRAC_1_PI,
+                );
+                let tau = std::f32::consts::TAU * s.radius;
+                let dpdu = Vec3::new(d.z, 0.0, -d.x) * tau;
+                let (st, ct) = theta.sin_cos();
+                let dpdv = Vec3::new(-phi.sin() * st, ct, -phi.cos() * st)
+                    * (std::f32::consts::PI * s.radius);
+                (uv, rot * dpdu, rot * dpdv)
+            }
+            PrimKind::Rect | PrimKind::Disk => {
+                let q = &self.planars[l];
+                (
+                    Vec2::new(0.5 * (hit.u + 1.0), 0.5 * (hit.v + 1.0)),
+                    2.0 * q.u,
+                    2.0 * q.v,
+                )
+            }
+            PrimKind::Box => self.boxes[l].uv_frame(&ray_rest, hit.t),
+        };
+        match motion {
+            Some(m) => (
+                uv,
+                m.vector_to_world(dpdu, time),
+                m.vector_to_world(dpdv, time),
+            ),
+            None => (uv, dpdu, dpdv),
+        }
+    }
+
+    /// UV of a rest-pose point on an emitter (sphere, rect or disk), for textured emission
+    /// seen through light sampling.
+    pub fn uv_at(&self, i: u32, p: Vec3) -> Vec2 {
+        let l = self.local[i as usize] as usize;
+        match self.kind[i as usize] {
+            PrimKind::Sphere => {
+                let s = &self.spheres[l];
+                let d = (self.sphere_rotation[l].inverse() * (p - s.center)).normalize_or(Vec3::Y);
+                Vec2::new(
+                    0.5 + d.x.atan2(d.z) * std::f32::consts::FRAC_1_PI * 0.5,
+                    0.5 + d.y.clamp(-1.0, 1.0).asin() * std::f32::consts::FRAC_1_PI,
+                )
+            }
+            PrimKind::Rect | PrimKind::Disk => {
+                let (a, b) = self.planars[l].coords(p);
+                Vec2::new(0.5 * (a + 1.0), 0.5 * (b + 1.0))
+            }
+            PrimKind::Box => Vec2::ZERO,
+        }
+    }
+
+    #[inline]
+    pub fn texture_of(&self, i: u32) -> Option<&Texture> {
+        let t = self.texture[i as usize];
+        (t != NO_TEXTURE).then(|| &self.textures[t as usize])
+    }
+
     /// Number of primitives of each kind, for `prism info`.
     pub fn counts(&self) -> [(PrimKind, usize); 4] {
         let n = |k| self.kind.iter().filter(|&&x| x == k).count();
@@ -180,6 +273,7 @@ pub fn gather_primitives(world: &hecs::World) -> Primitives {
         Material,
         String,
         Option<Motion>,
+        Option<Texture>,
     );
     let mut rows: Vec<Row> = world
         .query::<(
@@ -189,12 +283,17 @@ pub fn gather_primitives(world: &hecs::World) -> Primitives {
             &Material,
             &Name,
             Option<&Motion>,
+            Option<&Texture>,
         )>()
         .iter()
-        .map(|(e, s, t, m, n, mo)| (e, *s, *t, *m, n.0.clone(), mo.copied()))
+        .map(|(e, s, t, m, n, mo, tx)| (e, *s, *t, *m, n.0.clone(), mo.copied(), tx.cloned()))
         .collect();
     rows.sort_by_key(|r| r.0.id());
-    for (entity, shape, transform, material, name, motion) in rows {
+    for (entity, shape, transform, material, name, motion, texture) in rows {
+        p.texture.push(texture.map_or(NO_TEXTURE, |t| {
+            p.textures.push(t);
+            (p.textures.len() - 1) as u32
+        }));
         let moving = motion.filter(|m| !m.is_static()).map(|m| {
             p.motions.push(RigidMotion {
                 pivot: transform.to_world.translation.into(),
@@ -214,6 +313,8 @@ pub fn gather_primitives(world: &hecs::World) -> Primitives {
                     center: tw.transform_point3(center),
                     radius: radius * scale,
                 });
+                let (_, rot, _) = tw.to_scale_rotation_translation();
+                p.sphere_rotation.push(rot);
                 (PrimKind::Sphere, p.spheres.len() - 1)
             }
             Shape::Rect { center, u, v } => {

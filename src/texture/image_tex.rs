@@ -1,0 +1,422 @@
+//! Image textures: decoding once into linear `f32` RGB, filtered lookups, and a cache so
+//! entities that name the same file share one copy.
+
+use std::collections::HashMap;
+use std::fmt;
+use std::io::{self, Cursor};
+use std::path::{Path, PathBuf};
+use std::sync::Arc;
+
+use glam::{Vec2, Vec3};
+use serde::{Deserialize, Serialize};
+
+use crate::film::output::{FilmError, read_image, srgb_decode};
+
+/// How texture coordinates outside [0, 1] are folded back onto the image.
+///
+/// Folding happens per texel index, so with bilinear filtering the edges behave as:
+/// - `Repeat`: the image tiles; exactly at u = 0 or u = 1 the result is the mean of the
+///   first and last column (they are neighbours across the seam).
+/// - `Clamp`: the edge texel extends outwards; u ≤ 1/(2·width) gives the first column.
+/// - `Mirror`: every other tile is flipped, so the edge texel is its own neighbour and u = 0
+///   or u = 1 gives the edge column, with no seam.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Deserialize, Serialize)]
+pub enum Wrap {
+    #[default]
+    Repeat,
+    Clamp,
+    Mirror,
+}
+
+/// How the integer samples of a file encode light.
+///
+/// Only 8- and 16-bit sources are affected: EXR and Radiance HDR store linear floats and are
+/// never decoded.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ColorSpace {
+    /// Colour images (albedo): samples are sRGB-encoded and decoded with [`srgb_decode`].
+    Srgb,
+    /// Data images (normal maps): samples are used as stored, scaled to [0, 1]. Decoding a
+    /// normal map as sRGB would bend every normal.
+    Linear,
+}
+
+/// Extensions [`TexImage::load`] accepts.
+pub const TEXTURE_EXTENSIONS: &str = ".png, .jpg, .jpeg, .hdr, .exr";
+
+/// Why a texture could not be loaded. Every message names the file.
+#[derive(Debug, thiserror::Error)]
+pub enum TextureError {
+    #[error("texture '{}' not found", .path.display())]
+    Missing { path: PathBuf },
+    #[error("cannot read texture '{}': {}", .path.display(), io_reason(.error))]
+    Unreadable { path: PathBuf, error: io::Error },
+    #[error(
+        "texture '{}': unsupported image format ({found}); supported extensions: {}",
+        .path.display(), TEXTURE_EXTENSIONS
+    )]
+    UnsupportedFormat { path: PathBuf, found: String },
+    #[error("cannot decode texture '{}': {message}", .path.display())]
+    Decode { path: PathBuf, message: String },
+}
+
+impl TextureError {
+    /// The file the error is about.
+    pub fn path(&self) -> &Path {
+        match self {
+            Self::Missing { path }
+            | Self::Unreadable { path, .. }
+            | Self::UnsupportedFormat { path, .. }
+            | Self::Decode { path, .. } => path,
+        }
+    }
+
+    fn from_io(path: &Path, error: io::Error) -> Self {
+        if error.kind() == io::ErrorKind::NotFound {
+            Self::Missing {
+                path: path.to_path_buf(),
+            }
+        } else {
+            Self::Unreadable {
+                path: path.to_path_buf(),
+                error,
+            }
+        }
+    }
+}
+
+/// An OS error as a short lowercase phrase that reads well after "cannot read 'x': ".
+fn io_reason(error: &io::Error) -> String {
+    let text = error.to_string();
+    let text = match text.rfind(" (os error ") {
+        Some(i) if text.ends_with(')') => &text[..i],
+        _ => &text,
+    };
+    let mut chars = text.chars();
+    match chars.next() {
+        Some(first) => first.to_lowercase().chain(chars).collect(),
+        None => String::new(),
+    }
+}
+
+/// A decoded texture: linear RGB, row-major, top row of the file first.
+///
+/// Lookups use the OpenGL convention: v = 0 is the bottom row, v = 1 the top, and texel
+/// (x, y) (y counted from the top, as in the file) has its centre at
+/// u = (x + ½) / width, v = 1 − (y + ½) / height.
+#[derive(Clone, PartialEq)]
+pub struct TexImage {
+    width: u32,
+    height: u32,
+    pixels: Vec<[f32; 3]>,
+}
+
+impl fmt::Debug for TexImage {
+    // The pixel buffer would drown any message that prints a texture.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("TexImage")
+            .field("width", &self.width)
+            .field("height", &self.height)
+            .finish_non_exhaustive()
+    }
+}
+
+impl TexImage {
+    /// An in-memory texture from linear RGB pixels, top row first.
+    ///
+    /// # Panics
+    /// If a side is zero or `pixels.len() != width * height`.
+    pub fn from_pixels(width: u32, height: u32, pixels: Vec<[f32; 3]>) -> Self {
+        assert!(width > 0 && height > 0, "texture must be non-empty");
+        assert_eq!(
+            pixels.len(),
+            width as usize * height as usize,
+            "pixel buffer does not match {width}×{height}"
+        );
+        Self {
+            width,
+            height,
+            pixels,
+        }
+    }
+
+    /// Reads and decodes `path` (chosen by extension: PNG, JPEG, Radiance HDR, OpenEXR).
+    ///
+    /// 8- and 16-bit samples are decoded according to `space`; float sources are linear
+    /// already. Alpha is dropped, grey is replicated to RGB.
+    pub fn load(path: &Path, space: ColorSpace) -> Result<Self, TextureError> {
+        let ext = path
+            .extension()
+            .map(|e| e.to_string_lossy().to_ascii_lowercase());
+        let format = match ext.as_deref() {
+            Some("png") => image::ImageFormat::Png,
+            Some("jpg" | "jpeg") => image::ImageFormat::Jpeg,
+            Some("hdr") => image::ImageFormat::Hdr,
+            Some("exr") => return Self::load_exr(path),
+            _ => {
+                return Err(TextureError::UnsupportedFormat {
+                    path: path.to_path_buf(),
+                    found: match path.extension() {
+                        Some(e) => format!("'.{}'", e.to_string_lossy()),
+                        None => "no extension".to_owned(),
+                    },
+                });
+            }
+        };
+        let bytes = std::fs::read(path).map_err(|e| TextureError::from_io(path, e))?;
+        Self::decode_raster(path, bytes, format, space)
+    }
+
+    /// EXR is always linear, so the film reader (which handles f16/f32/u32 channels and
+    /// finds the RGB layer) does exactly what is needed.
+    fn load_exr(path: &Path) -> Result<Self, TextureError> {
+        let decode = |message: String| TextureError::Decode {
+            path: path.to_path_buf(),
+            message,
+        };
+        let (img, _) = read_image(path).map_err(|e| match e {
+            FilmError::Read { error, .. } => TextureError::from_io(path, error),
+            FilmError::Decode { message, .. } => decode(message),
+            FilmError::MissingChannel {
+                channel, present, ..
+            } => decode(format!(
+                "no '{channel}' channel (channels present: {present})"
+            )),
+            other => decode(other.to_string()),
+        })?;
+        Self::checked(path, img.width, img.height, img.pixels)
+    }
+
+    fn decode_raster(
+        path: &Path,
+        bytes: Vec<u8>,
+        format: image::ImageFormat,
+        space: ColorSpace,
+    ) -> Result<Self, TextureError> {
+        let decode_err = |message: String| TextureError::Decode {
+            path: path.to_path_buf(),
+            message,
+        };
+        // Trust the content over the extension when they disagree.
+        let decoded = image::ImageReader::with_format(Cursor::new(bytes), format)
+            .with_guessed_format()
+            .map_err(|e| decode_err(e.to_string()))?
+            .decode()
+            .map_err(|e| decode_err(e.to_string()))?;
+        let color = decoded.color();
+        let bytes_per_sample = color.bytes_per_pixel() / color.channel_count();
+        let (width, height) = (decoded.width(), decoded.height());
+        let pixels: Vec<[f32; 3]> = match bytes_per_sample {
+            1 => {
+                // A table keeps loading a large photo cheap: 256 powf calls, not millions.
+                let lut: Vec<f32> = (0..=255u8)
+                    .map(|b| to_linear(b as f32 / 255.0, space))
+                    .collect();
+                decoded
+                    .into_rgb8()
+                    .pixels()
+                    .map(|p| p.0.map(|c| lut[c as usize]))
+                    .collect()
+            }
+            2 => {
+                let lut: Vec<f32> = (0..=u16::MAX)
+                    .map(|s| to_linear(s as f32 / 65535.0, space))
+                    .collect();
+                decoded
+                    .into_rgb16()
+                    .pixels()
+                    .map(|p| p.0.map(|c| lut[c as usize]))
+                    .collect()
+            }
+            // Float sources (Radiance HDR) hold linear radiance already.
+            _ => decoded.into_rgb32f().pixels().map(|p| p.0).collect(),
+        };
+        Self::checked(path, width, height, pixels)
+    }
+
+    fn checked(
+        path: &Path,
+        width: u32,
+        height: u32,
+        pixels: Vec<[f32; 3]>,
+    ) -> Result<Self, TextureError> {
+        if width == 0 || height == 0 || pixels.len() != width as usize * height as usize {
+            return Err(TextureError::Decode {
+                path: path.to_path_buf(),
+                message: format!("image is {width}×{height}; both sides must be non-zero"),
+            });
+        }
+        Ok(Self {
+            width,
+            height,
+            pixels,
+        })
+    }
+
+    pub fn width(&self) -> u32 {
+        self.width
+    }
+
+    pub fn height(&self) -> u32 {
+        self.height
+    }
+
+    /// Texel `(x, y)` with y counted from the top row, as stored in the file.
+    ///
+    /// # Panics
+    /// If the coordinates are outside the image.
+    pub fn pixel(&self, x: u32, y: u32) -> Vec3 {
+        assert!(
+            x < self.width && y < self.height,
+            "texel ({x}, {y}) outside image"
+        );
+        Vec3::from_array(self.pixels[y as usize * self.width as usize + x as usize])
+    }
+
+    /// Bilinearly filtered linear RGB at `uv` (v = 0 at the bottom row).
+    ///
+    /// Allocates nothing and never panics: NaN or infinite coordinates are treated as 0, and
+    /// huge finite ones are folded into range before they are scaled to texels.
+    #[inline]
+    pub fn bilinear(&self, uv: Vec2, wrap: Wrap) -> Vec3 {
+        let (x0, x1, fx) = axis(uv.x, self.width, wrap);
+        let (y0, y1, fy) = axis(uv.y, self.height, wrap);
+        let w = self.width as usize;
+        // Axis indices count from the bottom; storage rows from the top.
+        let row = |j: u32| (self.height - 1 - j) as usize * w;
+        let at = |i: u32, r: usize| Vec3::from_array(self.pixels[r + i as usize]);
+        let (r0, r1) = (row(y0), row(y1));
+        let bottom = at(x0, r0).lerp(at(x1, r0), fx);
+        let top = at(x0, r1).lerp(at(x1, r1), fx);
+        bottom.lerp(top, fy)
+    }
+
+    /// Rec. 709 luminance of the filtered colour.
+    #[inline]
+    pub fn luminance(&self, uv: Vec2, wrap: Wrap) -> f32 {
+        self.bilinear(uv, wrap)
+            .dot(Vec3::new(0.2126, 0.7152, 0.0722))
+    }
+}
+
+fn to_linear(encoded: f32, space: ColorSpace) -> f32 {
+    match space {
+        ColorSpace::Srgb => srgb_decode(encoded),
+        ColorSpace::Linear => encoded,
+    }
+}
+
+/// The two texel indices along one axis that straddle `t` (counted from the start of the
+/// axis) and the weight of the second one.
+#[inline]
+fn axis(t: f32, n: u32, wrap: Wrap) -> (u32, u32, f32) {
+    let t = if t.is_finite() { t } else { 0.0 };
+    // Fold into one period first so `t * n` cannot overflow; `rem_euclid` is exact here, so
+    // in-range coordinates are unchanged.
+    let t = match wrap {
+        Wrap::Repeat => t.rem_euclid(1.0),
+        Wrap::Mirror => t.rem_euclid(2.0),
+        Wrap::Clamp => t.clamp(0.0, 1.0),
+    };
+    // Texel i covers [i, i + 1) in texel units, so its centre is at i + ½.
+    let x = t * n as f32 - 0.5;
+    let base = x.floor();
+    let frac = x - base;
+    let i = base as i64;
+    (fold(i, n, wrap), fold(i + 1, n, wrap), frac)
+}
+
+#[inline]
+fn fold(i: i64, n: u32, wrap: Wrap) -> u32 {
+    let n = i64::from(n);
+    let j = match wrap {
+        Wrap::Repeat => i.rem_euclid(n),
+        Wrap::Clamp => i.clamp(0, n - 1),
+        Wrap::Mirror => {
+            let m = i.rem_euclid(2 * n);
+            if m < n { m } else { 2 * n - 1 - m }
+        }
+    };
+    j as u32
+}
+
+/// Loads each (file, colour space) once and hands out shared images.
+///
+/// Paths are compared after canonicalisation when the file exists, so `a/../t.png` and
+/// `t.png` share one image. The same file in two colour spaces is two different images.
+#[derive(Debug, Default)]
+pub struct TextureCache {
+    images: HashMap<(PathBuf, ColorSpace), Arc<TexImage>>,
+}
+
+impl TextureCache {
+    pub fn new() -> Self {
+        Self::default()
+    }
+
+    /// The image at `path` decoded for `space`, loading it on first use. Errors name `path`
+    /// as given.
+    pub fn get(&mut self, path: &Path, space: ColorSpace) -> Result<Arc<TexImage>, TextureError> {
+        let key = (
+            std::fs::canonicalize(path).unwrap_or_else(|_| path.to_path_buf()),
+            space,
+        );
+        if let Some(img) = self.images.get(&key) {
+            return Ok(Arc::clone(img));
+        }
+        let img = Arc::new(TexImage::load(path, space)?);
+        self.images.insert(key, Arc::clone(&img));
+        Ok(img)
+    }
+
+    /// Number of distinct images loaded.
+    pub fn len(&self) -> usize {
+        self.images.len()
+    }
+
+    pub fn is_empty(&self) -> bool {
+        self.images.is_empty()
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn fold_matches_documented_modes() {
+        let n = 4;
+        let r: Vec<u32> = (-5..9).map(|i| fold(i, n, Wrap::Repeat)).collect();
+        assert_eq!(r, [3, 0, 1, 2, 3, 0, 1, 2, 3, 0, 1, 2, 3, 0]);
+        let c: Vec<u32> = (-2..6).map(|i| fold(i, n, Wrap::Clamp)).collect();
+        assert_eq!(c, [0, 0, 0, 1, 2, 3, 3, 3]);
+        let m: Vec<u32> = (-5..13).map(|i| fold(i, n, Wrap::Mirror)).collect();
+        assert_eq!(m, [3, 3, 2, 1, 0, 0, 1, 2, 3, 3, 2, 1, 0, 0, 1, 2, 3, 3]);
+    }
+
+    #[test]
+    fn axis_handles_extremes_without_overflow() {
+        for wrap in [Wrap::Repeat, Wrap::Clamp, Wrap::Mirror] {
+            for t in [f32::MAX, f32::MIN, 1e30, -1e30, f32::NAN, f32::INFINITY] {
+                let (a, b, f) = axis(t, 7, wrap);
+                assert!(a < 7 && b < 7 && (0.0..=1.0).contains(&f), "{wrap:?} {t}");
+            }
+        }
+    }
+
+    #[test]
+    fn bottom_row_is_v_zero() {
+        // 1×2: top texel red, bottom texel blue.
+        let img = TexImage::from_pixels(1, 2, vec![[1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]);
+        assert_eq!(img.bilinear(Vec2::new(0.5, 0.25), Wrap::Clamp), Vec3::Z);
+        assert_eq!(img.bilinear(Vec2::new(0.5, 0.75), Wrap::Clamp), Vec3::X);
+    }
+
+    #[test]
+    fn io_reason_is_short_and_lowercase() {
+        assert_eq!(
+            io_reason(&io::Error::from_raw_os_error(13)),
+            "permission denied"
+        );
+    }
+}
