@@ -18,3 +18,4 @@ $p costs scenes/cornell.ron scenes/caustics.ron scenes/motion_blur.ron scenes/ea
 
 
 echo "wrote $out"
+python3 scripts/readme_figures.py

@@ -1,0 +1,15 @@
+#!/usr/bin/env python3
+"""Pastes the tables under assets/accuracy/ into README.md between marker comments."""
+import pathlib, re
+root = pathlib.Path(__file__).resolve().parent.parent
+readme = root / "README.md"
+text = readme.read_text()
+def table(path):
+    lines = (root / path).read_text().splitlines()
+    return "\n".join(l for l in lines if l.startswith("|"))
+for key, path in [("CORNELL", "assets/accuracy/cornell/summary.md"),
+                  ("CAUSTICS", "assets/accuracy/caustics/summary.md"),
+                  ("COSTS", "assets/accuracy/effect_costs.md")]:
+    block = f"<!-- {key} -->\n{table(path)}\n<!-- /{key} -->"
+    text = re.sub(rf"<!-- {key} -->.*?<!-- /{key} -->|FIGURES_{key}", lambda _: block, text, flags=re.S)
+readme.write_text(text)
