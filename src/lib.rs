@@ -12,6 +12,7 @@ pub mod film;
 pub mod geometry;
 pub mod integrator;
 pub mod kdtree;
+pub mod medium;
 pub mod report;
 pub mod sampling;
 pub mod scene_file;
