@@ -530,6 +530,18 @@ fn print_stats(rs: &RenderScene, out: &integrator::RenderOutput, output: &Path, 
         s.shadow_rays,
         (s.rays + s.shadow_rays) as f64 / out.seconds.max(1e-9) * 1e-6
     );
+    let r = &s.revolution;
+    if r.rays > 0 {
+        eprintln!(
+            "surfaces of revolution: {} rays, {} candidate spans, {} brackets, {} Newton iterations ({:.2} per bracket), {} not converged",
+            r.rays,
+            r.candidate_spans,
+            r.brackets,
+            r.newton_iterations,
+            r.newton_iterations as f64 / r.brackets.max(1) as f64,
+            r.non_converged
+        );
+    }
     let k = rs.accel.stats();
     eprintln!(
         "kd-tree: {} primitives, {} nodes, depth {}, {:.2} primitives per leaf, built in {:.3} ms",

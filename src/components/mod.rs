@@ -1,12 +1,14 @@
 //! ECS components: plain data attached to scene entities by `scene_file::load`.
 
 pub mod camera;
+pub mod light;
 pub mod material;
 pub mod motion;
 pub mod shape;
 pub mod texture;
 
 pub use camera::Camera;
+pub use light::PointLight;
 pub use material::Material;
 pub use motion::Motion;
 pub use shape::Shape;

@@ -12,10 +12,13 @@
 //! # let _ = s;
 //! ```
 //! `Rect` spans `center ± u ± v` (half edges) and faces `normalize(u × v)`; `Box` is closed.
+//! `Revolution(profile: [(radius, height), ...], tolerance: 1e-6)` revolves a clamped uniform
+//! cubic B-spline about the local y axis; a profile that starts and ends on the axis is closed.
 
 use glam::Vec3;
+use std::sync::Arc;
 
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Debug)]
 pub enum Shape {
     Sphere {
         center: Vec3,
@@ -35,6 +38,8 @@ pub enum Shape {
         min: Vec3,
         max: Vec3,
     },
+    /// A revolved B-spline profile, shared by every entity with the same profile.
+    Revolution(Arc<crate::geometry::Revolution>),
 }
 
 impl Shape {
@@ -44,11 +49,16 @@ impl Shape {
             Shape::Rect { .. } => "Rect",
             Shape::Disk { .. } => "Disk",
             Shape::Box { .. } => "Box",
+            Shape::Revolution(_) => "Revolution",
         }
     }
 
     /// Closed shapes have an inside (media and dielectrics rely on it).
     pub fn is_closed(&self) -> bool {
-        matches!(self, Shape::Sphere { .. } | Shape::Box { .. })
+        match self {
+            Shape::Sphere { .. } | Shape::Box { .. } => true,
+            Shape::Revolution(r) => r.is_closed(),
+            _ => false,
+        }
     }
 }

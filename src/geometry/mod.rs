@@ -9,3 +9,5 @@ pub use ray::{Ray, offset_ray_origin, spawn_ray, spawn_ray_to};
 pub use shapes::{OrientedBox, Planar, ShapeSample, Sphere, SurfacePoint};
 pub mod motion;
 pub use motion::RigidMotion;
+pub mod revolution;
+pub use revolution::{Revolution, RevolutionHit, RevolutionStats};

@@ -62,6 +62,8 @@ pub fn tiles(width: u32, height: u32) -> Vec<Tile> {
 /// Counters of one render.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq)]
 pub struct RenderStats {
+    /// Newton iterations and brackets of surfaces of revolution.
+    pub revolution: crate::geometry::RevolutionStats,
     /// Camera samples whose radiance reached the film.
     pub samples: u64,
     /// Samples whose radiance was not finite: dropped and counted, never written.
@@ -76,6 +78,7 @@ impl RenderStats {
         self.dropped += o.dropped;
         self.rays += o.rays;
         self.shadow_rays += o.shadow_rays;
+        self.revolution += o.revolution;
     }
 }
 
@@ -223,6 +226,7 @@ fn render_with<const SPECTRAL: bool, const MEDIA: bool, const MOTION: bool>(
                         reference::render_tile::<MOTION>(&ctx, tile, s0, s0 + n, &mut film, &mut st)
                     }
                 }
+                st.revolution += crate::systems::primitives::take_revolution_stats();
                 progress(tile.pixels() as u64 * n as u64);
                 (film, st)
             })

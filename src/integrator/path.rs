@@ -286,10 +286,22 @@ pub fn shade<const MOTION: bool>(
                     if cos > 0.0 && ls.wi.dot(nf) > 0.0 {
                         let bsdf_pdf = cos * std::f32::consts::FRAC_1_PI;
                         let f = albedo * std::f32::consts::FRAC_1_PI * cos;
-                        let w = power_heuristic(ls.pdf, bsdf_pdf);
+                        let w = if ls.delta {
+                            1.0
+                        } else {
+                            power_heuristic(ls.pdf, bsdf_pdf)
+                        };
                         let contrib = s.beta * f * ls.radiance * (w / ls.pdf);
                         if contrib != Vec3::ZERO {
                             let (ray, t_max) = match ls.point {
+                                // A point light sits on no surface: stop just short of it.
+                                Some((q, _)) if ls.delta => (
+                                    Ray::new(
+                                        offset_ray_origin(sp.p, nf),
+                                        q - offset_ray_origin(sp.p, nf),
+                                    ),
+                                    1.0 - 1e-4,
+                                ),
                                 Some((q, nq)) => spawn_ray_to(sp.p, nf, q, nq),
                                 None => {
                                     (Ray::new(offset_ray_origin(sp.p, nf), ls.wi), f32::INFINITY)

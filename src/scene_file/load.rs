@@ -117,6 +117,7 @@ pub const OVERRIDE_KEYS: &[&str] = &[
     "camera.lens.aperture_radius",
     "camera.lens.focus_distance",
     "camera.lens.blades",
+    "render.newton_tolerance",
     "environment",
 ];
 
@@ -160,6 +161,7 @@ pub fn apply_override(scene: &mut schema::Scene, key: &str, value: &str) -> Resu
             c.lens.get_or_insert_with(lens).focus_distance = val(key, value)?
         }
         "camera.lens.blades" => c.lens.get_or_insert_with(lens).blades = val(key, value)?,
+        "render.newton_tolerance" => r.newton_tolerance = Some(val(key, value)?),
         "environment" => scene.environment = Some(val(key, value)?),
         _ => {
             return Err(SceneError::Override {
@@ -277,10 +279,51 @@ fn build_world(scene: schema::Scene, path: &Path, hash: u64) -> Result<LoadedSce
             message,
         };
         let transform = transform_of(&e.transform);
+        if let Some(l) = &e.light {
+            if e.shape.is_some() || e.material.is_some() {
+                return Err(err(
+                    "light",
+                    "a point or spot light has no shape or material; use a Light material for an area light".into(),
+                ));
+            }
+            let light = match l {
+                schema::LightSpec::Point {
+                    position,
+                    intensity,
+                } => crate::components::light::PointLight {
+                    position: transform.to_world.transform_point3(position.vec()),
+                    direction: glam::Vec3::NEG_Y,
+                    intensity: intensity.0.vec(),
+                    cos_cone: -1.0,
+                    cos_falloff_start: -1.0,
+                },
+                schema::LightSpec::Spot {
+                    position,
+                    direction,
+                    cone,
+                    falloff,
+                    intensity,
+                } => crate::components::light::PointLight {
+                    position: transform.to_world.transform_point3(position.vec()),
+                    direction: transform
+                        .to_world
+                        .transform_vector3(direction.vec())
+                        .normalize(),
+                    intensity: intensity.0.vec(),
+                    cos_cone: cone.to_radians().cos(),
+                    cos_falloff_start: (cone - falloff).to_radians().cos(),
+                },
+            };
+            world.spawn((Name(name), light));
+            continue;
+        }
         let Some(shape) = &e.shape else {
-            return Err(err("shape", "every entity needs a shape".into()));
+            return Err(err(
+                "shape",
+                "every entity needs a shape (or a light: Point or Spot)".into(),
+            ));
         };
-        let shape = match *shape {
+        let shape = match shape.clone() {
             schema::Shape::Sphere { center, radius } => {
                 if transform.uniform_scale.is_none() {
                     return Err(err(
@@ -311,6 +354,17 @@ fn build_world(scene: schema::Scene, path: &Path, hash: u64) -> Result<LoadedSce
                 min: min.vec(),
                 max: max.vec(),
             },
+            schema::Shape::Revolution { profile, tolerance } => {
+                let tol = scene
+                    .render
+                    .newton_tolerance
+                    .map(|t| t.0)
+                    .or(tolerance)
+                    .unwrap_or(crate::geometry::revolution::DEFAULT_TOLERANCE);
+                let rev = crate::geometry::Revolution::new(&profile, tol)
+                    .map_err(|m| err("shape", format!("Revolution: {m}")))?;
+                Shape::Revolution(std::sync::Arc::new(rev))
+            }
         };
         let material = match &e.material {
             None => {
@@ -328,10 +382,11 @@ fn build_world(scene: schema::Scene, path: &Path, hash: u64) -> Result<LoadedSce
                 emission,
                 two_sided,
             }) => {
-                if matches!(shape, Shape::Box { .. }) {
+                if matches!(shape, Shape::Box { .. } | Shape::Revolution(_)) {
                     return Err(err(
                         "material",
-                        "a Light needs a Sphere, Rect or Disk (area lights are sampled on those); use Rect faces for a box-shaped lamp".into(),
+                        "a Light needs a Sphere, Rect or Disk (area lights are sampled on those)"
+                            .into(),
                     ));
                 }
                 Material::Light {

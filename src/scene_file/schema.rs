@@ -39,6 +39,9 @@ pub struct Render {
     pub seed: u64,
     #[serde(default)]
     pub integrator: IntegratorSettings,
+    /// Overrides every surface of revolution's Newton tolerance (for accuracy studies).
+    #[serde(default)]
+    pub newton_tolerance: Option<Positive>,
 }
 
 fn default_width() -> ImageDim {
@@ -66,6 +69,7 @@ impl Default for Render {
             max_depth: default_max_depth(),
             seed: default_seed(),
             integrator: IntegratorSettings::default(),
+            newton_tolerance: None,
         }
     }
 }
@@ -262,6 +266,85 @@ impl TryFrom<AnimationSpec> for Animation {
     }
 }
 
+/// A light without a shape: a point or a spot. `intensity` is radiant intensity (radiance
+/// times area per solid angle); `cone` is the half-angle of the spot's cone in degrees and
+/// `falloff` the width of the soft edge inside it.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields, try_from = "LightSpecRaw")]
+pub enum LightSpec {
+    Point {
+        position: V3,
+        intensity: Emission,
+    },
+    Spot {
+        position: V3,
+        direction: V3,
+        cone: f32,
+        falloff: f32,
+        intensity: Emission,
+    },
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+enum LightSpecRaw {
+    Point {
+        position: V3,
+        intensity: Emission,
+    },
+    Spot {
+        position: V3,
+        direction: V3,
+        cone: f32,
+        #[serde(default)]
+        falloff: f32,
+        intensity: Emission,
+    },
+}
+
+impl TryFrom<LightSpecRaw> for LightSpec {
+    type Error = String;
+    fn try_from(l: LightSpecRaw) -> Result<Self, String> {
+        Ok(match l {
+            LightSpecRaw::Point {
+                position,
+                intensity,
+            } => LightSpec::Point {
+                position,
+                intensity,
+            },
+            LightSpecRaw::Spot {
+                position,
+                direction,
+                cone,
+                falloff,
+                intensity,
+            } => {
+                if direction.vec().length_squared() == 0.0 {
+                    return Err("Spot: direction must be a non-zero vector".into());
+                }
+                if !(cone > 0.0 && cone <= 90.0) {
+                    return Err(format!(
+                        "Spot: cone must be in (0, 90] degrees (a half-angle), got {cone}"
+                    ));
+                }
+                if !(0.0..=cone).contains(&falloff) {
+                    return Err(format!(
+                        "Spot: falloff must be in [0, cone] = [0, {cone}] degrees, got {falloff}"
+                    ));
+                }
+                LightSpec::Spot {
+                    position,
+                    direction,
+                    cone,
+                    falloff,
+                    intensity,
+                }
+            }
+        })
+    }
+}
+
 /// Background radiance seen by escaping rays.
 #[derive(Clone, Debug, Deserialize)]
 pub enum Environment {
@@ -287,7 +370,7 @@ pub struct Entity {
     #[serde(default)]
     pub medium: Option<NotYetMedium>,
     #[serde(default)]
-    pub light: Option<NotYetLight>,
+    pub light: Option<LightSpec>,
 }
 
 #[derive(Clone, Debug, Deserialize)]
@@ -310,6 +393,11 @@ pub enum Shape {
     Box {
         min: V3,
         max: V3,
+    },
+    /// A cubic B-spline profile (radius, height) revolved about the local y axis.
+    Revolution {
+        profile: Vec<(f32, f32)>,
+        tolerance: Option<f32>,
     },
 }
 
@@ -339,8 +427,9 @@ enum ShapeSpec {
         path: IgnoredAny,
     },
     Revolution {
-        #[allow(dead_code)]
-        profile: IgnoredAny,
+        profile: Vec<(f32, f32)>,
+        #[serde(default)]
+        tolerance: Option<f32>,
     },
 }
 
@@ -388,10 +477,21 @@ impl TryFrom<ShapeSpec> for Shape {
                     "Mesh shapes are not supported by this build yet (triangle meshes)".into(),
                 );
             }
-            ShapeSpec::Revolution { .. } => {
-                return Err(
-                    "Revolution shapes are not supported by this build yet (surfaces of revolution)".into(),
-                );
+            ShapeSpec::Revolution { profile, tolerance } => {
+                if let Some(t) = tolerance
+                    && !(t.is_finite() && t > 0.0 && t < 0.1)
+                {
+                    return Err(format!(
+                        "Revolution: tolerance must be in (0, 0.1), got {t}"
+                    ));
+                }
+                // Checked here so a bad profile keeps its line and column.
+                crate::geometry::Revolution::new(
+                    &profile,
+                    tolerance.unwrap_or(crate::geometry::revolution::DEFAULT_TOLERANCE),
+                )
+                .map_err(|e| format!("Revolution: {e}"))?;
+                Shape::Revolution { profile, tolerance }
             }
         })
     }
@@ -682,4 +782,3 @@ macro_rules! not_yet {
 }
 
 not_yet!(NotYetMedium, "medium", "participating media");
-not_yet!(NotYetLight, "light", "point and spot lights");

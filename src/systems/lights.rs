@@ -11,6 +11,8 @@ pub enum LightKind {
     Area(u32),
     /// The constant environment: radiance from every direction.
     Environment(Vec3),
+    /// A point or spot light (a delta light: never found by chance).
+    Point(crate::components::PointLight),
 }
 
 /// A light sample as seen from a reference point.
@@ -22,8 +24,11 @@ pub struct LightSample {
     pub point: Option<(Vec3, Vec3)>,
     /// Radiance arriving along `-wi`.
     pub radiance: Vec3,
-    /// Solid-angle density, including the probability of choosing this light.
+    /// Solid-angle density, including the probability of choosing this light; for a delta
+    /// light, the probability of choosing it.
     pub pdf: f32,
+    /// A point or spot light: no other technique can find it, so MIS gives it full weight.
+    pub delta: bool,
 }
 
 pub struct Lights {
@@ -62,6 +67,20 @@ impl Lights {
                     point: None,
                     radiance: l,
                     pdf: pmf * crate::sampling::uniform_sphere_pdf(),
+                    delta: false,
+                })
+            }
+            LightKind::Point(pl) => {
+                let d = pl.position - p;
+                let d2 = d.length_squared();
+                let wi = d / d2.sqrt();
+                let radiance = pl.intensity_towards(-wi) / d2;
+                (radiance != Vec3::ZERO && radiance.is_finite()).then_some(LightSample {
+                    wi,
+                    point: Some((pl.position, Vec3::ZERO)),
+                    radiance,
+                    pdf: pmf,
+                    delta: true,
                 })
             }
             LightKind::Area(prim) => {
@@ -72,7 +91,7 @@ impl Lights {
                     PrimKind::Sphere => prims.spheres[l].sample(p_rest, u),
                     PrimKind::Rect => prims.planars[l].sample(p_rest, u, false),
                     PrimKind::Disk => prims.planars[l].sample(p_rest, u, true),
-                    PrimKind::Box => None,
+                    PrimKind::Box | PrimKind::Revolution => None,
                 }?;
                 if let Some(m) = motion {
                     s.p = m.point_to_world(s.p, time);
@@ -93,6 +112,7 @@ impl Lights {
                     point: Some((s.p, s.n)),
                     radiance,
                     pdf: pmf * s.pdf,
+                    delta: false,
                 })
             }
         }
@@ -124,7 +144,7 @@ impl Lights {
         pmf * match prims.kind[prim as usize] {
             PrimKind::Sphere => prims.spheres[l].pdf(p, q, n),
             PrimKind::Rect | PrimKind::Disk => prims.planars[l].pdf(p, q),
-            PrimKind::Box => 0.0,
+            PrimKind::Box | PrimKind::Revolution => 0.0,
         }
     }
 
@@ -143,9 +163,24 @@ fn luminance(c: Vec3) -> f32 {
 
 /// Collects the emitters and builds the power-proportional selection table. Records each
 /// emitter's light index on its primitive, so a path that hits it by chance finds its pdf.
-pub fn gather_lights(prims: &mut Primitives, environment: Vec3, scene_bounds: &Aabb) -> Lights {
+pub fn gather_lights(
+    world: &hecs::World,
+    prims: &mut Primitives,
+    environment: Vec3,
+    scene_bounds: &Aabb,
+) -> Lights {
     let mut lights = Vec::new();
     let mut power = Vec::new();
+    let mut points: Vec<(hecs::Entity, crate::components::PointLight)> = world
+        .query::<(hecs::Entity, &crate::components::PointLight)>()
+        .iter()
+        .map(|(e, l)| (e, *l))
+        .collect();
+    points.sort_by_key(|(e, _)| e.id());
+    for (_, l) in points {
+        lights.push(LightKind::Point(l));
+        power.push(luminance(l.power()).max(1e-6));
+    }
     for i in 0..prims.len() {
         let m = prims.materials[prims.material[i] as usize];
         if !m.is_emissive() {
@@ -155,7 +190,7 @@ pub fn gather_lights(prims: &mut Primitives, environment: Vec3, scene_bounds: &A
         let area = match prims.kind[i] {
             PrimKind::Sphere => prims.spheres[l].area(),
             PrimKind::Rect | PrimKind::Disk => prims.planars[l].area(),
-            PrimKind::Box => continue,
+            PrimKind::Box | PrimKind::Revolution => continue,
         };
         let (e, sides) = match m {
             crate::components::Material::Light {

@@ -68,7 +68,7 @@ pub fn prepare_frame(scene: &LoadedScene, params: &KdParams, frame: u32) -> Rend
     let accel = build_accel(&prims, params);
     let accel_seconds = t0.elapsed().as_secs_f64();
     let bounds: Aabb = accel.bounds();
-    let lights = gather_lights(&mut prims, scene.environment, &bounds);
+    let lights = gather_lights(&scene.world, &mut prims, scene.environment, &bounds);
     let s = &scene.render;
     let camera_at = |t: f32| match &scene.camera_path {
         Some(p) => p.at(t, &scene.camera),
@@ -131,14 +131,10 @@ impl RenderScene {
     pub fn intersect<const MOTION: bool>(&self, ray: &Ray, t_max: f32, time: f32) -> Option<Hit> {
         let mut best = None;
         self.accel.closest_hit(ray, t_max, |prim, t_max| {
-            let (t, u, v) = self.prims.intersect_at::<MOTION>(prim, ray, t_max, time)?;
-            best = Some(Hit {
-                t,
-                prim,
-                sub: 0,
-                u,
-                v,
-            });
+            let (t, u, v, sub) = self
+                .prims
+                .intersect_sub_at::<MOTION>(prim, ray, t_max, time)?;
+            best = Some(Hit { t, prim, sub, u, v });
             Some(t)
         })?;
         best

@@ -2,9 +2,15 @@
 //! keeping each primitive's entity for messages and statistics.
 
 use crate::components::{Material, Motion, Name, Shape, Texture, Transform};
-use crate::geometry::{Aabb, OrientedBox, Planar, Ray, RigidMotion, Sphere, SurfacePoint};
+use crate::geometry::{
+    Aabb, OrientedBox, Planar, Ray, Revolution, RevolutionHit, RevolutionStats, RigidMotion,
+    Sphere, SurfacePoint,
+};
 use crate::kdtree::KdPrimitives;
+use glam::{Affine3A, Mat3};
 use glam::{Quat, Vec2, Vec3};
+use std::cell::Cell;
+use std::sync::Arc;
 
 /// The closed list of primitive kinds; the hot loop matches on it once per test.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -14,6 +20,82 @@ pub enum PrimKind {
     Rect,
     Disk,
     Box,
+    Revolution,
+}
+
+/// An object-space shape placed by an affine transform: rays go in, surface data comes out.
+#[derive(Clone, Debug)]
+pub struct Placed<T> {
+    pub shape: Arc<T>,
+    pub to_world: Affine3A,
+    pub to_object: Affine3A,
+    /// Inverse transpose of the linear part: carries normals to world space.
+    pub normal_matrix: Mat3,
+}
+
+impl<T> Placed<T> {
+    pub fn new(shape: Arc<T>, to_world: Affine3A) -> Self {
+        let to_object = to_world.inverse();
+        Self {
+            shape,
+            to_world,
+            to_object,
+            normal_matrix: Mat3::from(to_object.matrix3).transpose(),
+        }
+    }
+
+    #[inline]
+    pub fn ray_to_object(&self, ray: &Ray) -> Ray {
+        Ray::new(
+            self.to_object.transform_point3(ray.o),
+            self.to_object.transform_vector3(ray.d),
+        )
+    }
+
+    pub fn world_bounds(&self, b: &Aabb) -> Aabb {
+        let mut w = Aabb::EMPTY;
+        for i in 0..8 {
+            let c = Vec3::new(
+                if i & 1 == 0 { b.min.x } else { b.max.x },
+                if i & 2 == 0 { b.min.y } else { b.max.y },
+                if i & 4 == 0 { b.min.z } else { b.max.z },
+            );
+            w = w.union_point(self.to_world.transform_point3(c));
+        }
+        w.padded(1e-6, 0.0)
+    }
+
+    /// Object-space surface data to world space.
+    #[inline]
+    pub fn surface_to_world(&self, sp: SurfacePoint) -> SurfacePoint {
+        SurfacePoint {
+            p: self.to_world.transform_point3(sp.p),
+            n: (self.normal_matrix * sp.n).normalize(),
+            ns: (self.normal_matrix * sp.ns).normalize(),
+            front: sp.front,
+        }
+    }
+}
+
+thread_local! {
+    // Newton statistics of surfaces of revolution: counted per worker thread without locks,
+    // collected by each tile into its render statistics.
+    static REVOLUTION_STATS: Cell<RevolutionStats> = Cell::new(RevolutionStats::default());
+}
+
+/// Takes the calling thread's revolution counters, leaving zeros.
+pub fn take_revolution_stats() -> RevolutionStats {
+    REVOLUTION_STATS.with(|c| c.replace(RevolutionStats::default()))
+}
+
+#[inline]
+fn with_rev_stats<R>(f: impl FnOnce(&mut RevolutionStats) -> R) -> R {
+    REVOLUTION_STATS.with(|c| {
+        let mut s = c.get();
+        let r = f(&mut s);
+        c.set(s);
+        r
+    })
 }
 
 /// What the intersect stage records: small, so the stage streams through memory.
@@ -54,6 +136,7 @@ pub struct Primitives {
     pub sphere_rotation: Vec<Quat>,
     pub planars: Vec<Planar>,
     pub boxes: Vec<OrientedBox>,
+    pub revolutions: Vec<Placed<Revolution>>,
     pub materials: Vec<Material>,
     pub names: Vec<String>,
 }
@@ -83,6 +166,10 @@ impl Primitives {
             PrimKind::Rect => self.planars[l].bounds(false),
             PrimKind::Disk => self.planars[l].bounds(true),
             PrimKind::Box => self.boxes[l].bounds(),
+            PrimKind::Revolution => {
+                let r = &self.revolutions[l];
+                r.world_bounds(&r.shape.bounds())
+            }
         }
     }
 
@@ -110,6 +197,21 @@ impl Primitives {
             return self.intersect(i, &m.ray_to_rest(ray, time), t_max);
         }
         self.intersect(i, ray, t_max)
+    }
+
+    /// `intersect_at` with the part of the primitive that was hit.
+    #[inline]
+    pub fn intersect_sub_at<const MOTION: bool>(
+        &self,
+        i: u32,
+        ray: &Ray,
+        t_max: f32,
+        time: f32,
+    ) -> Option<(f32, f32, f32, u32)> {
+        if MOTION && let Some(m) = self.motion_of(i) {
+            return self.intersect_sub(i, &m.ray_to_rest(ray, time), t_max);
+        }
+        self.intersect_sub(i, ray, t_max)
     }
 
     /// Surface data at `time` (see `intersect_at`).
@@ -142,6 +244,34 @@ impl Primitives {
             PrimKind::Box => self.boxes[l]
                 .intersect(ray, t_max)
                 .map(|(t, out)| (t, out as u32 as f32, 0.0)),
+            // The hit keeps the curve parameter in u, the span parameter in v; the span goes
+            // through `intersect_sub`.
+            PrimKind::Revolution => self
+                .intersect_sub(i, ray, t_max)
+                .map(|(t, u, v, _)| (t, u, v)),
+        }
+    }
+
+    /// Like `intersect`, with the part of the primitive that was hit (a revolution's span).
+    #[inline]
+    pub fn intersect_sub(&self, i: u32, ray: &Ray, t_max: f32) -> Option<(f32, f32, f32, u32)> {
+        let l = self.local[i as usize] as usize;
+        match self.kind[i as usize] {
+            PrimKind::Revolution => {
+                let r = &self.revolutions[l];
+                let h = with_rev_stats(|st| r.shape.intersect(&r.ray_to_object(ray), t_max, st))?;
+                Some((h.t, h.s, h.u, h.span))
+            }
+            _ => self.intersect(i, ray, t_max).map(|(t, u, v)| (t, u, v, 0)),
+        }
+    }
+
+    fn revolution_hit(hit: &Hit) -> RevolutionHit {
+        RevolutionHit {
+            t: hit.t,
+            s: hit.u,
+            span: hit.sub,
+            u: hit.v,
         }
     }
 
@@ -153,6 +283,13 @@ impl Primitives {
             PrimKind::Sphere => self.spheres[l].surface(ray, hit.t, hit.u > 0.5),
             PrimKind::Rect | PrimKind::Disk => self.planars[l].surface(ray, hit.u, hit.v),
             PrimKind::Box => self.boxes[l].surface(ray, hit.t, hit.u > 0.5),
+            PrimKind::Revolution => {
+                let r = &self.revolutions[l];
+                let (sp, _, _, _) = r
+                    .shape
+                    .surface(&r.ray_to_object(ray), &Self::revolution_hit(hit));
+                r.surface_to_world(sp)
+            }
         }
     }
 
@@ -202,6 +339,17 @@ impl Primitives {
                 )
             }
             PrimKind::Box => self.boxes[l].uv_frame(&ray_rest, hit.t),
+            PrimKind::Revolution => {
+                let r = &self.revolutions[l];
+                let (_, uv, dpdu, dpdv) = r
+                    .shape
+                    .surface(&r.ray_to_object(&ray_rest), &Self::revolution_hit(hit));
+                (
+                    uv,
+                    r.to_world.transform_vector3(dpdu),
+                    r.to_world.transform_vector3(dpdv),
+                )
+            }
         };
         match motion {
             Some(m) => (
@@ -230,7 +378,7 @@ impl Primitives {
                 let (a, b) = self.planars[l].coords(p);
                 Vec2::new(0.5 * (a + 1.0), 0.5 * (b + 1.0))
             }
-            PrimKind::Box => Vec2::ZERO,
+            PrimKind::Box | PrimKind::Revolution => Vec2::ZERO,
         }
     }
 
@@ -241,13 +389,14 @@ impl Primitives {
     }
 
     /// Number of primitives of each kind, for `prism info`.
-    pub fn counts(&self) -> [(PrimKind, usize); 4] {
+    pub fn counts(&self) -> [(PrimKind, usize); 5] {
         let n = |k| self.kind.iter().filter(|&&x| x == k).count();
         [
             (PrimKind::Sphere, n(PrimKind::Sphere)),
             (PrimKind::Rect, n(PrimKind::Rect)),
             (PrimKind::Disk, n(PrimKind::Disk)),
             (PrimKind::Box, n(PrimKind::Box)),
+            (PrimKind::Revolution, n(PrimKind::Revolution)),
         ]
     }
 }
@@ -286,7 +435,9 @@ pub fn gather_primitives(world: &hecs::World) -> Primitives {
             Option<&Texture>,
         )>()
         .iter()
-        .map(|(e, s, t, m, n, mo, tx)| (e, *s, *t, *m, n.0.clone(), mo.copied(), tx.cloned()))
+        .map(|(e, s, t, m, n, mo, tx)| {
+            (e, s.clone(), *t, *m, n.0.clone(), mo.copied(), tx.cloned())
+        })
         .collect();
     rows.sort_by_key(|r| r.0.id());
     for (entity, shape, transform, material, name, motion, texture) in rows {
@@ -343,6 +494,10 @@ pub fn gather_primitives(world: &hecs::World) -> Primitives {
             Shape::Box { min, max } => {
                 p.boxes.push(OrientedBox::new(min, max, tw));
                 (PrimKind::Box, p.boxes.len() - 1)
+            }
+            Shape::Revolution(r) => {
+                p.revolutions.push(Placed::new(r, tw));
+                (PrimKind::Revolution, p.revolutions.len() - 1)
             }
         };
         p.kind.push(kind);
