@@ -26,6 +26,8 @@ pub enum Material {
     Dielectric { ior: f32 },
     /// An area emitter of constant radiance.
     Light { emission: Vec3, two_sided: bool },
+    /// No surface at all: the boundary of a medium, crossed without scattering.
+    Boundary,
 }
 
 impl Material {
@@ -43,7 +45,7 @@ impl Material {
                 emission: emission * a,
                 two_sided,
             },
-            m @ Material::Dielectric { .. } => m,
+            m @ (Material::Dielectric { .. } | Material::Boundary) => m,
         }
     }
 

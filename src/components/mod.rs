@@ -3,6 +3,7 @@
 pub mod camera;
 pub mod light;
 pub mod material;
+pub mod medium;
 pub mod motion;
 pub mod shape;
 pub mod texture;
@@ -10,6 +11,7 @@ pub mod texture;
 pub use camera::Camera;
 pub use light::PointLight;
 pub use material::Material;
+pub use medium::Medium;
 pub use motion::Motion;
 pub use shape::Shape;
 pub use texture::Texture;

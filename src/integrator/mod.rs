@@ -212,7 +212,7 @@ fn render_with<const SPECTRAL: bool, const MEDIA: bool, const MOTION: bool>(
                 let mut st = RenderStats::default();
                 match opts.integrator {
                     Integrator::Wavefront => QUEUES.with_borrow_mut(|q| {
-                        wavefront::render_tile::<MOTION>(
+                        wavefront::render_tile::<MOTION, MEDIA>(
                             &ctx,
                             q,
                             tile,
@@ -222,9 +222,14 @@ fn render_with<const SPECTRAL: bool, const MEDIA: bool, const MOTION: bool>(
                             &mut st,
                         )
                     }),
-                    Integrator::Reference => {
-                        reference::render_tile::<MOTION>(&ctx, tile, s0, s0 + n, &mut film, &mut st)
-                    }
+                    Integrator::Reference => reference::render_tile::<MOTION, MEDIA>(
+                        &ctx,
+                        tile,
+                        s0,
+                        s0 + n,
+                        &mut film,
+                        &mut st,
+                    ),
                 }
                 st.revolution += crate::systems::primitives::take_revolution_stats();
                 progress(tile.pixels() as u64 * n as u64);
@@ -252,7 +257,7 @@ fn render_with<const SPECTRAL: bool, const MEDIA: bool, const MOTION: bool>(
             pass *= 2;
         }
     }
-    let _ = (SPECTRAL, MEDIA);
+    let _ = SPECTRAL;
     RenderOutput {
         width: w,
         height: h,

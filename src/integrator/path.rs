@@ -4,8 +4,10 @@
 use super::bsdf::{fresnel_dielectric, fresnel_schlick, reflect, refract};
 use crate::components::Material;
 use crate::geometry::{Ray, offset_ray_origin, spawn_ray_to};
+use crate::medium::DistanceSample;
 use crate::sampling::{self, Sampler};
 use crate::scene_file::schema::{Fresnel, LightSampling};
+use crate::systems::primitives::NO_MEDIUM;
 use crate::systems::{Hit, RenderScene, primitives::emitted};
 use glam::{Vec2, Vec3};
 
@@ -20,6 +22,11 @@ pub const DIM_BOUNCE: u32 = 8;
 /// Dimensions each scattering event may use: light choice (1), light point (2), lobe (1),
 /// direction (2), Russian roulette (1), and one reserved.
 pub const DIMS_PER_BOUNCE: u32 = 8;
+/// Medium segments take their dimensions from a separate range, 8 per segment: channel,
+/// distance, light choice, light point (2), phase direction (2), Russian roulette. A path may
+/// cross boundaries without scattering, so segments are counted apart from bounces.
+pub const DIM_MEDIA: u32 = 1 << 20;
+pub const DIMS_PER_SEGMENT: u32 = 8;
 
 /// Per-render constants of the shading step, hoisted out of the per-ray loop.
 #[derive(Clone, Copy)]
@@ -82,14 +89,20 @@ pub struct PathState {
     pub pixel: u32,
     pub sample: u32,
     pub alive: bool,
+    /// The medium the ray travels in (`NO_MEDIUM` for none).
+    pub medium: u32,
+    /// Medium segments sampled so far (their sample dimensions).
+    pub segments: u32,
 }
 
-/// A shadow ray whose contribution lands on the path if nothing blocks it.
+/// A shadow ray whose contribution lands on the path if nothing blocks it (with MEDIA, scaled
+/// by the transmittance along it, starting in `medium`).
 #[derive(Clone, Copy, Debug)]
 pub struct ShadowRequest {
     pub ray: Ray,
     pub t_max: f32,
     pub contrib: Vec3,
+    pub medium: u32,
 }
 
 #[inline]
@@ -155,6 +168,8 @@ pub fn camera_ray<const MOTION: bool>(ctx: &Ctx, x: u32, y: u32, index: u32) -> 
         pixel,
         sample: index,
         alive: true,
+        medium: ctx.scene.camera_medium,
+        segments: 0,
     }
 }
 
@@ -202,7 +217,7 @@ fn below(wt: Vec3, n: Vec3) -> Vec3 {
 /// Processes the vertex where `s.ray` ends: adds emission found there (MIS-weighted), then
 /// either ends the path or scatters it, returning a shadow ray for next-event estimation.
 #[inline]
-pub fn shade<const MOTION: bool>(
+pub fn shade<const MOTION: bool, const MEDIA: bool>(
     ctx: &Ctx,
     s: &mut PathState,
     hit: Option<Hit>,
@@ -210,6 +225,26 @@ pub fn shade<const MOTION: bool>(
     let scene = ctx.scene;
     let lights = &scene.lights;
     let wo = -s.ray.d;
+    if MEDIA && s.medium != NO_MEDIUM {
+        let med = scene.prims.media[s.medium as usize];
+        let dim = DIM_MEDIA + s.segments * DIMS_PER_SEGMENT;
+        s.segments += 1;
+        let (pixel, index) = (s.pixel, s.sample);
+        let t_hit = hit.map_or(f32::INFINITY, |h| h.t);
+        let u_c = ctx.sampler.get_1d(pixel, index, dim);
+        let u_t = ctx.sampler.get_1d(pixel, index, dim + 1);
+        match med.sample_distance(t_hit, u_c, u_t, s.beta) {
+            DistanceSample::Pass { weight } => s.beta *= weight,
+            DistanceSample::Scatter { t, weight } => {
+                s.beta *= weight;
+                return scatter_in_medium::<MOTION>(ctx, s, &med, s.ray.at(t), dim);
+            }
+        }
+        if s.beta == Vec3::ZERO {
+            s.alive = false;
+            return None;
+        }
+    }
     let mis_emitter = |s: &PathState, pdf_light: f32| -> f32 {
         if s.depth == 0 || s.specular || !ctx.nee {
             1.0
@@ -243,6 +278,12 @@ pub fn shade<const MOTION: bool>(
             let ns = tex.shading_normal(uv, sp.ns, dpdu, dpdv);
             sp.ns = if ns.dot(sp.n) < 0.0 { -ns } else { ns };
         }
+    }
+    if MEDIA && let Material::Boundary = material {
+        // A medium's boundary: carry on in the same direction, in the medium beyond.
+        s.medium = prims.medium_after_crossing(hit.prim, sp.front, s.medium);
+        s.ray = Ray::new(offset_ray_origin(sp.p, -sp.facing()), s.ray.d);
+        return None;
     }
     if let Material::Light { .. } = material {
         let le = emitted(&material, sp.n, wo);
@@ -311,6 +352,7 @@ pub fn shade<const MOTION: bool>(
                                 ray,
                                 t_max,
                                 contrib,
+                                medium: s.medium,
                             });
                         }
                     }
@@ -355,6 +397,9 @@ pub fn shade<const MOTION: bool>(
                     // Radiance is compressed by 1/η² crossing into a denser medium.
                     s.beta /= eta * eta;
                     s.eta_scale *= eta * eta;
+                    if MEDIA {
+                        s.medium = prims.medium_after_crossing(hit.prim, sp.front, s.medium);
+                    }
                     s.ray = Ray::new(offset_ray_origin(sp.p, -nf), below(wt, nf));
                 }
                 _ => {
@@ -365,17 +410,27 @@ pub fn shade<const MOTION: bool>(
                 }
             }
         }
-        Material::Light { .. } => unreachable!("handled above"),
+        Material::Light { .. } | Material::Boundary => {
+            // Lights returned above; a boundary exists only with MEDIA, which handled it.
+            s.alive = false;
+            return None;
+        }
     }
     s.prev_p = sp.p;
-    // Russian roulette on the throughput with the IOR compression removed.
+    russian_roulette(ctx, s, dim + 6);
+    shadow
+}
+
+/// Russian roulette on the throughput with the IOR compression removed.
+#[inline]
+fn russian_roulette(ctx: &Ctx, s: &mut PathState, dim: u32) {
     if s.depth >= ctx.rr_depth {
         let rr = (s.beta * s.eta_scale).max_element();
         if rr < 1.0 {
             let q = (1.0 - rr).max(0.0);
-            if ctx.sampler.get_1d(pixel, index, dim + 6) < q {
+            if ctx.sampler.get_1d(s.pixel, s.sample, dim) < q {
                 s.alive = false;
-                return shadow;
+                return;
             }
             s.beta /= 1.0 - q;
         }
@@ -383,5 +438,67 @@ pub fn shade<const MOTION: bool>(
     if s.beta == Vec3::ZERO {
         s.alive = false;
     }
+}
+
+/// A scattering event inside a medium at `p`: next-event estimation through the phase
+/// function (MIS with phase sampling), then a phase-sampled continuation.
+#[inline]
+fn scatter_in_medium<const MOTION: bool>(
+    ctx: &Ctx,
+    s: &mut PathState,
+    med: &crate::medium::HomogeneousMedium,
+    p: Vec3,
+    dim: u32,
+) -> Option<ShadowRequest> {
+    if s.depth >= ctx.max_depth {
+        s.alive = false;
+        return None;
+    }
+    s.depth += 1;
+    let (pixel, index) = (s.pixel, s.sample);
+    let wo = -s.ray.d;
+    let mut shadow = None;
+    if ctx.nee {
+        let u_sel = ctx.sampler.get_1d(pixel, index, dim + 2);
+        let u_l = ctx.sampler.get_2d(pixel, index, dim + 3);
+        let prims = &ctx.scene.prims;
+        if let Some(ls) =
+            ctx.scene
+                .lights
+                .sample::<MOTION>(prims, p, u_sel, u_l, s.time, ctx.textures)
+        {
+            let ph = med.phase(wo, ls.wi);
+            let w = if ls.delta {
+                1.0
+            } else {
+                power_heuristic(ls.pdf, ph)
+            };
+            let contrib = s.beta * ls.radiance * (ph * w / ls.pdf);
+            if contrib != Vec3::ZERO && contrib.is_finite() {
+                // A point in a medium lies on no surface: no offset at this end.
+                let (ray, t_max) = match ls.point {
+                    Some((q, _)) if ls.delta => (Ray::new(p, q - p), 1.0 - 1e-4),
+                    Some((q, nq)) => {
+                        let d = q - p;
+                        let nt = if nq.dot(d) <= 0.0 { nq } else { -nq };
+                        (Ray::new(p, offset_ray_origin(q, nt) - p), 1.0)
+                    }
+                    None => (Ray::new(p, ls.wi), f32::INFINITY),
+                };
+                shadow = Some(ShadowRequest {
+                    ray,
+                    t_max,
+                    contrib,
+                    medium: s.medium,
+                });
+            }
+        }
+    }
+    let (wi, pdf) = med.sample_phase(wo, ctx.sampler.get_2d(pixel, index, dim + 5));
+    s.prev_pdf = pdf;
+    s.specular = false;
+    s.prev_p = p;
+    s.ray = Ray::new(p, wi);
+    russian_roulette(ctx, s, dim + 7);
     shadow
 }

@@ -5,7 +5,7 @@
 use super::path::{Ctx, camera_ray, shade};
 use super::{RenderStats, Tile};
 
-pub fn render_tile<const MOTION: bool>(
+pub fn render_tile<const MOTION: bool, const MEDIA: bool>(
     ctx: &Ctx,
     tile: &Tile,
     s0: u32,
@@ -20,9 +20,14 @@ pub fn render_tile<const MOTION: bool>(
             while s.alive {
                 let hit = ctx.scene.intersect::<MOTION>(&s.ray, f32::INFINITY, s.time);
                 stats.rays += 1;
-                if let Some(r) = shade::<MOTION>(ctx, &mut s, hit) {
+                if let Some(r) = shade::<MOTION, MEDIA>(ctx, &mut s, hit) {
                     stats.shadow_rays += 1;
-                    if !ctx.scene.occluded::<MOTION>(&r.ray, r.t_max, s.time) {
+                    if MEDIA {
+                        s.l += r.contrib
+                            * ctx
+                                .scene
+                                .transmittance::<MOTION>(&r.ray, r.t_max, s.time, r.medium);
+                    } else if !ctx.scene.occluded::<MOTION>(&r.ray, r.t_max, s.time) {
                         s.l += r.contrib;
                     }
                 }

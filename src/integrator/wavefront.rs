@@ -28,6 +28,8 @@ pub struct RayQueue {
     pixel: Vec<u32>,
     sample: Vec<u32>,
     alive: Vec<bool>,
+    medium: Vec<u32>,
+    segments: Vec<u32>,
 }
 
 impl RayQueue {
@@ -47,6 +49,8 @@ impl RayQueue {
             pixel: vec![0; cap],
             sample: vec![0; cap],
             alive: vec![false; cap],
+            medium: vec![0; cap],
+            segments: vec![0; cap],
         }
     }
 
@@ -69,6 +73,8 @@ impl RayQueue {
             pixel: self.pixel[i],
             sample: self.sample[i],
             alive: self.alive[i],
+            medium: self.medium[i],
+            segments: self.segments[i],
         }
     }
 
@@ -87,6 +93,8 @@ impl RayQueue {
         self.pixel[i] = s.pixel;
         self.sample[i] = s.sample;
         self.alive[i] = s.alive;
+        self.medium[i] = s.medium;
+        self.segments[i] = s.segments;
     }
 }
 
@@ -98,6 +106,7 @@ struct ShadowQueue {
     t_max: Vec<f32>,
     time: Vec<f32>,
     contrib: Vec<Vec3>,
+    medium: Vec<u32>,
     slot: Vec<u32>,
 }
 
@@ -110,6 +119,7 @@ impl ShadowQueue {
             t_max: vec![0.0; cap],
             time: vec![0.0; cap],
             contrib: vec![Vec3::ZERO; cap],
+            medium: vec![0; cap],
             slot: vec![0; cap],
         }
     }
@@ -122,6 +132,7 @@ impl ShadowQueue {
         self.d[i] = r.ray.d;
         self.t_max[i] = r.t_max;
         self.contrib[i] = r.contrib;
+        self.medium[i] = r.medium;
         self.slot[i] = slot as u32;
         self.len += 1;
     }
@@ -155,7 +166,7 @@ impl Default for Queues {
 
 /// Renders samples `s0..s1` of every pixel of `tile`, adding each finished path's radiance to
 /// `film` (the tile's pixels, row-major).
-pub fn render_tile<const MOTION: bool>(
+pub fn render_tile<const MOTION: bool, const MEDIA: bool>(
     ctx: &Ctx,
     q: &mut Queues,
     tile: &Tile,
@@ -197,16 +208,22 @@ pub fn render_tile<const MOTION: bool>(
         q.shadow.len = 0;
         for i in 0..n {
             let mut s = q.rays.load(i);
-            if let Some(r) = shade::<MOTION>(ctx, &mut s, q.hits[i]) {
+            if let Some(r) = shade::<MOTION, MEDIA>(ctx, &mut s, q.hits[i]) {
                 q.shadow.push(&r, i, s.time);
             }
             q.rays.store(i, &s);
         }
-        // Stage 5, shadow: any-hit tests; unblocked light samples land on their path.
+        // Stage 5, shadow: any-hit tests (with MEDIA, transmittance through medium
+        // boundaries); unblocked light samples land on their path.
         let sh = &q.shadow;
         for j in 0..sh.len {
             let ray = Ray::new(sh.o[j], sh.d[j]);
-            if !ctx.scene.occluded::<MOTION>(&ray, sh.t_max[j], sh.time[j]) {
+            if MEDIA {
+                let tr =
+                    ctx.scene
+                        .transmittance::<MOTION>(&ray, sh.t_max[j], sh.time[j], sh.medium[j]);
+                q.rays.l[sh.slot[j] as usize] += sh.contrib[j] * tr;
+            } else if !ctx.scene.occluded::<MOTION>(&ray, sh.t_max[j], sh.time[j]) {
                 q.rays.l[sh.slot[j] as usize] += sh.contrib[j];
             }
         }

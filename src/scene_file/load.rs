@@ -366,7 +366,19 @@ fn build_world(scene: schema::Scene, path: &Path, hash: u64) -> Result<LoadedSce
                 Shape::Revolution(std::sync::Arc::new(rev))
             }
         };
+        let medium = e
+            .medium
+            .as_ref()
+            .map(|m| crate::medium::HomogeneousMedium::new(m.sigma_a.vec(), m.sigma_s.vec(), m.g));
+        if medium.is_some() && !matches!(shape, Shape::Sphere { .. } | Shape::Box { .. }) {
+            return Err(err(
+                "medium",
+                "a medium needs a closed Sphere or Box around it (its inside must be decidable)"
+                    .into(),
+            ));
+        }
         let material = match &e.material {
+            None if medium.is_some() => Material::Boundary,
             None => {
                 return Err(err(
                     "material",
@@ -395,6 +407,17 @@ fn build_world(scene: schema::Scene, path: &Path, hash: u64) -> Result<LoadedSce
                 }
             }
         };
+        if medium.is_some()
+            && matches!(
+                material,
+                Material::Mirror { .. } | Material::Light { .. } | Material::Diffuse { .. }
+            )
+        {
+            return Err(err(
+                "medium",
+                "a medium fills a pure boundary (no material) or a Dielectric; an opaque surface would hide it".into(),
+            ));
+        }
         let texture = match &e.texture {
             Some(spec) => Some(
                 spec.build(scene_dir, &mut textures)
@@ -406,6 +429,11 @@ fn build_world(scene: schema::Scene, path: &Path, hash: u64) -> Result<LoadedSce
         if let Some(t) = texture {
             world
                 .insert_one(entity, t)
+                .expect("entity was just spawned");
+        }
+        if let Some(m) = medium {
+            world
+                .insert_one(entity, m)
                 .expect("entity was just spawned");
         }
         if let Some(m) = &e.motion {

@@ -45,10 +45,7 @@ impl Effect {
 
     /// Whether this build can simulate the effect at all.
     pub fn implemented(self) -> bool {
-        matches!(
-            self,
-            Effect::Lens | Effect::Motion | Effect::Textures | Effect::NormalMaps
-        )
+        !matches!(self, Effect::Spectral)
     }
 }
 
@@ -178,7 +175,6 @@ pub fn detect_effects(
         false,
         "no dispersive IOR and no spectral emitter",
     );
-    fx.set(Effect::Media, false, "no Medium component");
     let named = |f: &dyn Fn(&Texture) -> bool| -> Vec<String> {
         world
             .query::<(&Name, &Texture)>()
@@ -212,6 +208,20 @@ pub fn detect_effects(
             Effect::NormalMaps,
             true,
             format!("normal map on entity {}", list(&normals)),
+        );
+    }
+    let media: Vec<String> = world
+        .query::<(&Name, &crate::components::Medium)>()
+        .iter()
+        .map(|(n, _)| format!("\"{}\"", n.0))
+        .collect();
+    if media.is_empty() {
+        fx.set(Effect::Media, false, "no Medium component");
+    } else {
+        fx.set(
+            Effect::Media,
+            true,
+            format!("Medium on entity {}", list(&media)),
         );
     }
     fx

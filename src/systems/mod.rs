@@ -28,6 +28,8 @@ pub struct RenderScene {
     pub base_camera: Camera,
     pub camera_path: Option<CameraPath>,
     pub camera_moves: bool,
+    /// The medium around the camera (`primitives::NO_MEDIUM` for none).
+    pub camera_medium: u32,
     pub frame: u32,
     /// Shutter interval of this frame in scene time (frames): [frame + open, frame + close].
     pub shutter: (f32, f32),
@@ -83,6 +85,7 @@ pub fn prepare_frame(scene: &LoadedScene, params: &KdParams, frame: u32) -> Rend
         base_camera: scene.camera,
         camera_path: scene.camera_path.clone(),
         camera_moves,
+        camera_medium: prims.medium_at(camera_at(shutter.0).position),
         frame,
         shutter,
         prims,
@@ -138,6 +141,54 @@ impl RenderScene {
             Some(t)
         })?;
         best
+    }
+
+    /// Transmittance along a shadow ray that starts in `medium`: medium boundaries are crossed
+    /// (ordered traversal, Beer–Lambert per segment), any other surface blocks it.
+    pub fn transmittance<const MOTION: bool>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        time: f32,
+        mut medium: u32,
+    ) -> Vec3 {
+        let len = ray.d.length();
+        let mut r = *ray;
+        let mut t_left = t_max;
+        let mut tr = Vec3::ONE;
+        // A ray crosses each boundary once per pass through it; nesting deeper than this
+        // would be a loop from rounding, and the light is treated as blocked.
+        for _ in 0..64 {
+            let seg = |m: u32, t: f32| {
+                if m == primitives::NO_MEDIUM {
+                    Vec3::ONE
+                } else {
+                    self.prims.media[m as usize].transmittance(t * len)
+                }
+            };
+            let Some(hit) = self.intersect::<MOTION>(&r, t_left, time) else {
+                return tr * seg(medium, t_left);
+            };
+            let m = self.prims.materials[self.prims.material[hit.prim as usize] as usize];
+            if !matches!(m, crate::components::Material::Boundary) {
+                return Vec3::ZERO;
+            }
+            tr *= seg(medium, hit.t);
+            if tr == Vec3::ZERO {
+                return tr;
+            }
+            let sp = self.prims.surface_at::<MOTION>(&r, &hit, time);
+            medium = self.prims.medium_after_crossing(hit.prim, sp.front, medium);
+            // Continue from just past the boundary; the direction keeps its length, so the
+            // parameter left shrinks by what was travelled.
+            let o = crate::geometry::offset_ray_origin(sp.p, -sp.facing());
+            t_left -= ((o - r.o).dot(r.d) / (len * len)).max(0.0);
+            r = Ray::new(o, r.d);
+            if t_left <= 0.0 {
+                return tr;
+            }
+        }
+        Vec3::ZERO
     }
 
     /// Whether anything blocks `ray` before `t_max`, at `time` when MOTION is on.

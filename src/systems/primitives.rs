@@ -112,6 +112,7 @@ pub struct Hit {
 pub const NO_LIGHT: u32 = u32::MAX;
 pub const NO_MOTION: u32 = u32::MAX;
 pub const NO_TEXTURE: u32 = u32::MAX;
+pub const NO_MEDIUM: u32 = u32::MAX;
 
 /// Structure-of-arrays primitive store. Index `i` addresses `kind`, `local`, `material`,
 /// `light` and `entity`; `local[i]` indexes the array of its kind.
@@ -128,6 +129,11 @@ pub struct Primitives {
     pub motions: Vec<RigidMotion>,
     /// The time interval the kd-tree's bounds must cover (frames).
     pub sweep: (f32, f32),
+    /// The medium inside the primitive (index into `media`), else `NO_MEDIUM`.
+    pub medium_inside: Vec<u32>,
+    /// The medium around it: the innermost other medium shape holding it, else `NO_MEDIUM`.
+    pub medium_outside: Vec<u32>,
+    pub media: Vec<crate::medium::HomogeneousMedium>,
     /// Index into `textures`, else `NO_TEXTURE`.
     pub texture: Vec<u32>,
     pub textures: Vec<Texture>,
@@ -382,6 +388,61 @@ impl Primitives {
         }
     }
 
+    /// Whether point `p` lies inside closed primitive `i` (spheres and boxes, the shapes
+    /// that can hold a medium), and the primitive's volume for picking the innermost.
+    fn contains(&self, i: u32, p: Vec3) -> Option<f32> {
+        let l = self.local[i as usize] as usize;
+        match self.kind[i as usize] {
+            PrimKind::Sphere => {
+                let s = &self.spheres[l];
+                ((p - s.center).length_squared() < s.radius * s.radius).then(|| s.radius.powi(3))
+            }
+            PrimKind::Box => {
+                let b = &self.boxes[l];
+                let q = b.to_object.transform_point3(p);
+                let d = b.max - b.min;
+                (q.cmpgt(b.min).all() && q.cmplt(b.max).all())
+                    .then(|| d.x * d.y * d.z * b.to_world.matrix3.determinant().abs())
+            }
+            _ => None,
+        }
+    }
+
+    /// The medium at point `p`: that of the smallest medium shape containing it.
+    pub fn medium_at(&self, p: Vec3) -> u32 {
+        self.medium_at_excluding(p, None)
+    }
+
+    fn medium_at_excluding(&self, p: Vec3, skip: Option<u32>) -> u32 {
+        let mut best = (f32::INFINITY, NO_MEDIUM);
+        for i in 0..self.len() as u32 {
+            if Some(i) == skip || self.medium_inside[i as usize] == NO_MEDIUM {
+                continue;
+            }
+            if let Some(v) = self.contains(i, p)
+                && v < best.0
+            {
+                best = (v, self.medium_inside[i as usize]);
+            }
+        }
+        best.1
+    }
+
+    /// The medium a ray is in after crossing primitive `i`'s surface: its inside when
+    /// entering (arriving on the front), its outside when leaving.
+    #[inline]
+    pub fn medium_after_crossing(&self, i: u32, front: bool, current: u32) -> u32 {
+        let inside = self.medium_inside[i as usize];
+        if inside == NO_MEDIUM {
+            return current;
+        }
+        if front {
+            inside
+        } else {
+            self.medium_outside[i as usize]
+        }
+    }
+
     #[inline]
     pub fn texture_of(&self, i: u32) -> Option<&Texture> {
         let t = self.texture[i as usize];
@@ -423,6 +484,7 @@ pub fn gather_primitives(world: &hecs::World) -> Primitives {
         String,
         Option<Motion>,
         Option<Texture>,
+        Option<crate::medium::HomogeneousMedium>,
     );
     let mut rows: Vec<Row> = world
         .query::<(
@@ -433,14 +495,29 @@ pub fn gather_primitives(world: &hecs::World) -> Primitives {
             &Name,
             Option<&Motion>,
             Option<&Texture>,
+            Option<&crate::medium::HomogeneousMedium>,
         )>()
         .iter()
-        .map(|(e, s, t, m, n, mo, tx)| {
-            (e, s.clone(), *t, *m, n.0.clone(), mo.copied(), tx.cloned())
+        .map(|(e, s, t, m, n, mo, tx, me)| {
+            (
+                e,
+                s.clone(),
+                *t,
+                *m,
+                n.0.clone(),
+                mo.copied(),
+                tx.cloned(),
+                me.copied(),
+            )
         })
         .collect();
     rows.sort_by_key(|r| r.0.id());
-    for (entity, shape, transform, material, name, motion, texture) in rows {
+    for (entity, shape, transform, material, name, motion, texture, medium) in rows {
+        p.medium_inside.push(medium.map_or(NO_MEDIUM, |m| {
+            p.media.push(m);
+            (p.media.len() - 1) as u32
+        }));
+        p.medium_outside.push(NO_MEDIUM);
         p.texture.push(texture.map_or(NO_TEXTURE, |t| {
             p.textures.push(t);
             (p.textures.len() - 1) as u32
@@ -506,6 +583,13 @@ pub fn gather_primitives(world: &hecs::World) -> Primitives {
         p.light.push(NO_LIGHT);
         p.entity.push(entity);
         p.names.push(name);
+    }
+    // Each medium shape's outside is the innermost other medium shape holding its centre.
+    for i in 0..p.len() {
+        if p.medium_inside[i] != NO_MEDIUM {
+            let c = p.bounds_of(i as u32).center();
+            p.medium_outside[i] = p.medium_at_excluding(c, Some(i as u32));
+        }
     }
     p
 }
