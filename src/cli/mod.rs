@@ -600,6 +600,19 @@ fn info(a: InfoArgs) -> Result<(), CliError> {
             ""
         }
     );
+    for (i, m) in rs.prims.meshes.iter().enumerate() {
+        let b = m.shape.bounds();
+        println!(
+            "mesh {i}: {}; object bounds ({:.4}, {:.4}, {:.4})..({:.4}, {:.4}, {:.4})",
+            m.shape.stats(),
+            b.min.x,
+            b.min.y,
+            b.min.z,
+            b.max.x,
+            b.max.y,
+            b.max.z
+        );
+    }
     let k = rs.accel.stats();
     println!(
         "kd-tree: {} nodes ({} leaves, {} empty), depth {}, {:.2} primitives per leaf, {} references, built in {:.3} ms",

@@ -12,6 +12,7 @@
 //! # let _ = s;
 //! ```
 //! `Rect` spans `center ± u ± v` (half edges) and faces `normalize(u × v)`; `Box` is closed.
+//! `Mesh(path: "../assets/bunny.obj")` loads an OBJ or PLY file (relative to the scene file).
 //! `Revolution(profile: [(radius, height), ...], tolerance: 1e-6)` revolves a clamped uniform
 //! cubic B-spline about the local y axis; a profile that starts and ends on the axis is closed.
 
@@ -40,6 +41,9 @@ pub enum Shape {
     },
     /// A revolved B-spline profile, shared by every entity with the same profile.
     Revolution(Arc<crate::geometry::Revolution>),
+    /// A triangle mesh with its kd-tree, loaded and built once per file however many entities
+    /// use it.
+    Mesh(Arc<crate::geometry::TriangleMesh>),
 }
 
 impl Shape {
@@ -50,6 +54,7 @@ impl Shape {
             Shape::Disk { .. } => "Disk",
             Shape::Box { .. } => "Box",
             Shape::Revolution(_) => "Revolution",
+            Shape::Mesh(_) => "Mesh",
         }
     }
 
@@ -58,6 +63,7 @@ impl Shape {
         match self {
             Shape::Sphere { .. } | Shape::Box { .. } => true,
             Shape::Revolution(r) => r.is_closed(),
+            Shape::Mesh(m) => m.is_closed(),
             _ => false,
         }
     }

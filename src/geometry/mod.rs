@@ -11,3 +11,6 @@ pub mod motion;
 pub use motion::RigidMotion;
 pub mod revolution;
 pub use revolution::{Revolution, RevolutionHit, RevolutionStats};
+pub mod mesh;
+pub mod mesh_io;
+pub use mesh::{MeshHit, TriangleMesh};

@@ -270,6 +270,10 @@ fn build_world(scene: schema::Scene, path: &Path, hash: u64) -> Result<LoadedSce
     // One cache per scene: an image used by several entities is decoded once.
     let mut textures = crate::texture::TextureCache::default();
     let scene_dir = path.parent().unwrap_or(Path::new("."));
+    let mut meshes: std::collections::HashMap<
+        PathBuf,
+        std::sync::Arc<crate::geometry::TriangleMesh>,
+    > = std::collections::HashMap::new();
     for (i, e) in scene.entities.iter().enumerate() {
         let name = e.name.clone().unwrap_or_else(|| format!("#{i}"));
         let err = |field: &'static str, message: String| SceneError::Entity {
@@ -354,6 +358,21 @@ fn build_world(scene: schema::Scene, path: &Path, hash: u64) -> Result<LoadedSce
                 min: min.vec(),
                 max: max.vec(),
             },
+            schema::Shape::Mesh { path: p } => {
+                let file = scene_dir.join(&p);
+                let key = file.canonicalize().unwrap_or_else(|_| file.clone());
+                let mesh = match meshes.get(&key) {
+                    Some(m) => m.clone(),
+                    None => {
+                        let m = crate::geometry::mesh_io::load_mesh(&file)
+                            .map_err(|me| err("shape", format!("Mesh: {me}")))?;
+                        let m = std::sync::Arc::new(m);
+                        meshes.insert(key, m.clone());
+                        m
+                    }
+                };
+                Shape::Mesh(mesh)
+            }
             schema::Shape::Revolution { profile, tolerance } => {
                 let tol = scene
                     .render
@@ -394,7 +413,10 @@ fn build_world(scene: schema::Scene, path: &Path, hash: u64) -> Result<LoadedSce
                 emission,
                 two_sided,
             }) => {
-                if matches!(shape, Shape::Box { .. } | Shape::Revolution(_)) {
+                if matches!(
+                    shape,
+                    Shape::Box { .. } | Shape::Revolution(_) | Shape::Mesh(_)
+                ) {
                     return Err(err(
                         "material",
                         "a Light needs a Sphere, Rect or Disk (area lights are sampled on those)"
@@ -416,6 +438,15 @@ fn build_world(scene: schema::Scene, path: &Path, hash: u64) -> Result<LoadedSce
             return Err(err(
                 "medium",
                 "a medium fills a pure boundary (no material) or a Dielectric; an opaque surface would hide it".into(),
+            ));
+        }
+        if let (Some(_), Shape::Mesh(m)) = (&e.texture, &shape)
+            && m.uvs().is_none()
+        {
+            return Err(err(
+                "texture",
+                "this mesh has no UVs (vt lines or PLY u/v), so a texture cannot be placed on it"
+                    .into(),
             ));
         }
         let texture = match &e.texture {

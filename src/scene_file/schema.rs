@@ -436,6 +436,10 @@ pub enum Shape {
         min: V3,
         max: V3,
     },
+    /// A triangle mesh from an OBJ or PLY file, relative to the scene file.
+    Mesh {
+        path: String,
+    },
     /// A cubic B-spline profile (radius, height) revolved about the local y axis.
     Revolution {
         profile: Vec<(f32, f32)>,
@@ -465,8 +469,7 @@ enum ShapeSpec {
         max: V3,
     },
     Mesh {
-        #[allow(dead_code)]
-        path: IgnoredAny,
+        path: String,
     },
     Revolution {
         profile: Vec<(f32, f32)>,
@@ -514,10 +517,11 @@ impl TryFrom<ShapeSpec> for Shape {
                 }
                 Shape::Box { min, max }
             }
-            ShapeSpec::Mesh { .. } => {
-                return Err(
-                    "Mesh shapes are not supported by this build yet (triangle meshes)".into(),
-                );
+            ShapeSpec::Mesh { path } => {
+                if path.trim().is_empty() {
+                    return Err("Mesh: path must name an .obj or .ply file".into());
+                }
+                Shape::Mesh { path }
             }
             ShapeSpec::Revolution { profile, tolerance } => {
                 if let Some(t) = tolerance

@@ -91,7 +91,7 @@ impl Lights {
                     PrimKind::Sphere => prims.spheres[l].sample(p_rest, u),
                     PrimKind::Rect => prims.planars[l].sample(p_rest, u, false),
                     PrimKind::Disk => prims.planars[l].sample(p_rest, u, true),
-                    PrimKind::Box | PrimKind::Revolution => None,
+                    PrimKind::Box | PrimKind::Revolution | PrimKind::Mesh => None,
                 }?;
                 if let Some(m) = motion {
                     s.p = m.point_to_world(s.p, time);
@@ -144,7 +144,7 @@ impl Lights {
         pmf * match prims.kind[prim as usize] {
             PrimKind::Sphere => prims.spheres[l].pdf(p, q, n),
             PrimKind::Rect | PrimKind::Disk => prims.planars[l].pdf(p, q),
-            PrimKind::Box | PrimKind::Revolution => 0.0,
+            PrimKind::Box | PrimKind::Revolution | PrimKind::Mesh => 0.0,
         }
     }
 
@@ -190,7 +190,7 @@ pub fn gather_lights(
         let area = match prims.kind[i] {
             PrimKind::Sphere => prims.spheres[l].area(),
             PrimKind::Rect | PrimKind::Disk => prims.planars[l].area(),
-            PrimKind::Box | PrimKind::Revolution => continue,
+            PrimKind::Box | PrimKind::Revolution | PrimKind::Mesh => continue,
         };
         let (e, sides) = match m {
             crate::components::Material::Light {

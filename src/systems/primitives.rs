@@ -3,8 +3,8 @@
 
 use crate::components::{Material, Motion, Name, Shape, Texture, Transform};
 use crate::geometry::{
-    Aabb, OrientedBox, Planar, Ray, Revolution, RevolutionHit, RevolutionStats, RigidMotion,
-    Sphere, SurfacePoint,
+    Aabb, MeshHit, OrientedBox, Planar, Ray, Revolution, RevolutionHit, RevolutionStats,
+    RigidMotion, Sphere, SurfacePoint, TriangleMesh,
 };
 use crate::kdtree::KdPrimitives;
 use glam::{Affine3A, Mat3};
@@ -21,6 +21,7 @@ pub enum PrimKind {
     Disk,
     Box,
     Revolution,
+    Mesh,
 }
 
 /// An object-space shape placed by an affine transform: rays go in, surface data comes out.
@@ -143,6 +144,7 @@ pub struct Primitives {
     pub planars: Vec<Planar>,
     pub boxes: Vec<OrientedBox>,
     pub revolutions: Vec<Placed<Revolution>>,
+    pub meshes: Vec<Placed<TriangleMesh>>,
     pub materials: Vec<Material>,
     pub names: Vec<String>,
 }
@@ -175,6 +177,10 @@ impl Primitives {
             PrimKind::Revolution => {
                 let r = &self.revolutions[l];
                 r.world_bounds(&r.shape.bounds())
+            }
+            PrimKind::Mesh => {
+                let m = &self.meshes[l];
+                m.world_bounds(&m.shape.bounds())
             }
         }
     }
@@ -252,7 +258,7 @@ impl Primitives {
                 .map(|(t, out)| (t, out as u32 as f32, 0.0)),
             // The hit keeps the curve parameter in u, the span parameter in v; the span goes
             // through `intersect_sub`.
-            PrimKind::Revolution => self
+            PrimKind::Revolution | PrimKind::Mesh => self
                 .intersect_sub(i, ray, t_max)
                 .map(|(t, u, v, _)| (t, u, v)),
         }
@@ -268,7 +274,23 @@ impl Primitives {
                 let h = with_rev_stats(|st| r.shape.intersect(&r.ray_to_object(ray), t_max, st))?;
                 Some((h.t, h.s, h.u, h.span))
             }
+            // The bottom-level kd-tree in object space: barycentrics in (u, v), the triangle
+            // in `sub`.
+            PrimKind::Mesh => {
+                let m = &self.meshes[l];
+                let h = m.shape.intersect(&m.ray_to_object(ray), t_max)?;
+                Some((h.t, h.b1, h.b2, h.tri))
+            }
             _ => self.intersect(i, ray, t_max).map(|(t, u, v)| (t, u, v, 0)),
+        }
+    }
+
+    fn mesh_hit(hit: &Hit) -> MeshHit {
+        MeshHit {
+            t: hit.t,
+            tri: hit.sub,
+            b1: hit.u,
+            b2: hit.v,
         }
     }
 
@@ -295,6 +317,18 @@ impl Primitives {
                     .shape
                     .surface(&r.ray_to_object(ray), &Self::revolution_hit(hit));
                 r.surface_to_world(sp)
+            }
+            PrimKind::Mesh => {
+                let m = &self.meshes[l];
+                let ms = m.shape.surface(&Self::mesh_hit(hit));
+                let d = m.ray_to_object(ray).d;
+                m.surface_to_world(SurfacePoint {
+                    p: ms.p,
+                    n: ms.ng,
+                    ns: ms.ns,
+                    // A triangle is crossed once: the side is the sign of the crossing.
+                    front: d.dot(ms.ng) < 0.0,
+                })
             }
         }
     }
@@ -345,6 +379,15 @@ impl Primitives {
                 )
             }
             PrimKind::Box => self.boxes[l].uv_frame(&ray_rest, hit.t),
+            PrimKind::Mesh => {
+                let m = &self.meshes[l];
+                let ms = m.shape.surface(&Self::mesh_hit(hit));
+                (
+                    ms.uv,
+                    m.to_world.transform_vector3(ms.dpdu),
+                    m.to_world.transform_vector3(ms.dpdv),
+                )
+            }
             PrimKind::Revolution => {
                 let r = &self.revolutions[l];
                 let (_, uv, dpdu, dpdv) = r
@@ -384,7 +427,7 @@ impl Primitives {
                 let (a, b) = self.planars[l].coords(p);
                 Vec2::new(0.5 * (a + 1.0), 0.5 * (b + 1.0))
             }
-            PrimKind::Box | PrimKind::Revolution => Vec2::ZERO,
+            PrimKind::Box | PrimKind::Revolution | PrimKind::Mesh => Vec2::ZERO,
         }
     }
 
@@ -450,7 +493,7 @@ impl Primitives {
     }
 
     /// Number of primitives of each kind, for `prism info`.
-    pub fn counts(&self) -> [(PrimKind, usize); 5] {
+    pub fn counts(&self) -> [(PrimKind, usize); 6] {
         let n = |k| self.kind.iter().filter(|&&x| x == k).count();
         [
             (PrimKind::Sphere, n(PrimKind::Sphere)),
@@ -458,6 +501,7 @@ impl Primitives {
             (PrimKind::Disk, n(PrimKind::Disk)),
             (PrimKind::Box, n(PrimKind::Box)),
             (PrimKind::Revolution, n(PrimKind::Revolution)),
+            (PrimKind::Mesh, n(PrimKind::Mesh)),
         ]
     }
 }
@@ -575,6 +619,10 @@ pub fn gather_primitives(world: &hecs::World) -> Primitives {
             Shape::Revolution(r) => {
                 p.revolutions.push(Placed::new(r, tw));
                 (PrimKind::Revolution, p.revolutions.len() - 1)
+            }
+            Shape::Mesh(m) => {
+                p.meshes.push(Placed::new(m, tw));
+                (PrimKind::Mesh, p.meshes.len() - 1)
             }
         };
         p.kind.push(kind);
