@@ -193,3 +193,15 @@ fn set_overrides_a_value() {
     ]);
     assert!(err.contains("render.integrator.fresnel"), "{err}");
 }
+
+#[test]
+fn the_readme_scene_example_loads() {
+    // The README's scene is the schema's showcase: it must stay a valid scene.
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let readme = std::fs::read_to_string(root.join("README.md")).unwrap();
+    let start = readme.find("```ron\n").expect("a ron block") + 7;
+    let end = start + readme[start..].find("```").unwrap();
+    let scene =
+        prism::scene_file::load_str(&readme[start..end], &root.join("scenes/readme.ron"), &[]);
+    assert!(scene.is_ok(), "{}", scene.err().unwrap());
+}

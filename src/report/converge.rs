@@ -60,6 +60,7 @@ pub const VARY_ALIASES: &[(&str, &str)] = &[
     ("fresnel", "render.integrator.fresnel"),
     ("wavelengths", "render.integrator.wavelengths"),
     ("sampler", "render.integrator.sampler"),
+    ("newton_tolerance", "render.newton_tolerance"),
 ];
 
 fn apply_knob(c: &mut Config, key: &str, value: &str) -> Result<(), String> {
