@@ -16,5 +16,6 @@ pub mod medium;
 pub mod report;
 pub mod sampling;
 pub mod scene_file;
+pub mod spectrum;
 pub mod systems;
 pub mod texture;
