@@ -22,11 +22,12 @@ pub const DIM_BOUNCE: u32 = 8;
 /// Dimensions each scattering event may use: light choice (1), light point (2), lobe (1),
 /// direction (2), Russian roulette (1), and one reserved.
 pub const DIMS_PER_BOUNCE: u32 = 8;
-/// Medium segments take their dimensions from a separate range, 8 per segment: channel,
-/// distance, light choice, light point (2), phase direction (2), Russian roulette. A path may
-/// cross boundaries without scattering, so segments are counted apart from bounces.
+/// Medium segments take their dimensions from a separate range, 12 per segment: channel,
+/// distance, light choice, light point (2), phase direction (2), Russian roulette, and the
+/// equiangular technique's light choice and distance. A path may cross boundaries without
+/// scattering, so segments are counted apart from bounces.
 pub const DIM_MEDIA: u32 = 1 << 20;
-pub const DIMS_PER_SEGMENT: u32 = 8;
+pub const DIMS_PER_SEGMENT: u32 = 12;
 
 /// Per-render constants of the shading step, hoisted out of the per-ray loop.
 #[derive(Clone, Copy)]
@@ -42,6 +43,7 @@ pub struct Ctx<'a> {
     /// TEXTURES and NORMAL_MAPS: read once per render, never per ray from the world.
     pub textures: bool,
     pub normal_maps: bool,
+    pub equiangular: bool,
 }
 
 impl<'a> Ctx<'a> {
@@ -66,6 +68,7 @@ impl<'a> Ctx<'a> {
             lens,
             textures: scene.effects.has(crate::systems::Effect::Textures),
             normal_maps: scene.effects.has(crate::systems::Effect::NormalMaps),
+            equiangular: s.equiangular,
         }
     }
 }
@@ -217,10 +220,13 @@ fn below(wt: Vec3, n: Vec3) -> Vec3 {
 /// Processes the vertex where `s.ray` ends: adds emission found there (MIS-weighted), then
 /// either ends the path or scatters it, returning a shadow ray for next-event estimation.
 #[inline]
+///
+/// In a medium, a second shadow ray may come back in `extra`: the equiangular technique's.
 pub fn shade<const MOTION: bool, const MEDIA: bool>(
     ctx: &Ctx,
     s: &mut PathState,
     hit: Option<Hit>,
+    extra: &mut Option<ShadowRequest>,
 ) -> Option<ShadowRequest> {
     let scene = ctx.scene;
     let lights = &scene.lights;
@@ -233,11 +239,21 @@ pub fn shade<const MOTION: bool, const MEDIA: bool>(
         let t_hit = hit.map_or(f32::INFINITY, |h| h.t);
         let u_c = ctx.sampler.get_1d(pixel, index, dim);
         let u_t = ctx.sampler.get_1d(pixel, index, dim + 1);
-        match med.sample_distance(t_hit, u_c, u_t, s.beta) {
+        let probs = s.beta;
+        if ctx.equiangular && ctx.nee && s.depth < ctx.max_depth {
+            *extra = equiangular_nee(ctx, s, &med, t_hit, dim);
+        }
+        match med.sample_distance(t_hit, u_c, u_t, probs) {
             DistanceSample::Pass { weight } => s.beta *= weight,
             DistanceSample::Scatter { t, weight } => {
                 s.beta *= weight;
-                return scatter_in_medium::<MOTION>(ctx, s, &med, s.ray.at(t), dim);
+                let seg = Segment {
+                    ray: s.ray,
+                    t,
+                    t_hit,
+                    p_ff: med.distance_pdf(t, probs),
+                };
+                return scatter_in_medium::<MOTION>(ctx, s, &med, seg, dim);
             }
         }
         if s.beta == Vec3::ZERO {
@@ -440,16 +456,64 @@ fn russian_roulette(ctx: &Ctx, s: &mut PathState, dim: u32) {
     }
 }
 
-/// A scattering event inside a medium at `p`: next-event estimation through the phase
-/// function (MIS with phase sampling), then a phase-sampled continuation.
+/// Where free-flight sampling put a scattering event: the segment's ray, the distance, the
+/// segment's end and the density of that distance (for MIS with equiangular sampling).
+struct Segment {
+    ray: Ray,
+    t: f32,
+    t_hit: f32,
+    p_ff: f32,
+}
+
+/// Equiangular sampling (Kulla & Fajardo 2012): a scattering distance on the segment drawn
+/// towards a chosen point or spot light, whose single-scattering contribution is combined with
+/// free-flight sampling's by the balance heuristic over the two distance densities.
+#[inline]
+fn equiangular_nee(
+    ctx: &Ctx,
+    s: &PathState,
+    med: &crate::medium::HomogeneousMedium,
+    t_hit: f32,
+    dim: u32,
+) -> Option<ShadowRequest> {
+    let (pixel, index) = (s.pixel, s.sample);
+    let (pl, pmf) = ctx
+        .scene
+        .lights
+        .pick_point(ctx.sampler.get_1d(pixel, index, dim + 8))?;
+    let eq = crate::medium::Equiangular::new(s.ray.o, s.ray.d, 0.0, t_hit, pl.position)?;
+    let (t, p_eq) = eq.sample(ctx.sampler.get_1d(pixel, index, dim + 9));
+    let x = s.ray.at(t);
+    let d = pl.position - x;
+    let d2 = d.length_squared();
+    let wi = d / d2.sqrt();
+    let radiance = pl.intensity_towards(-wi) / d2;
+    let p_ff = med.distance_pdf(t, s.beta);
+    let contrib = s.beta
+        * med.sigma_s
+        * med.transmittance(t)
+        * radiance
+        * (med.phase(-s.ray.d, wi) / (pmf * (p_eq + p_ff)));
+    (contrib != Vec3::ZERO && contrib.is_finite()).then_some(ShadowRequest {
+        ray: Ray::new(x, d),
+        t_max: 1.0 - 1e-4,
+        contrib,
+        medium: s.medium,
+    })
+}
+
+/// A scattering event inside a medium: next-event estimation through the phase function
+/// (MIS with phase sampling; for point and spot lights, balance-heuristic MIS with the
+/// equiangular technique), then a phase-sampled continuation.
 #[inline]
 fn scatter_in_medium<const MOTION: bool>(
     ctx: &Ctx,
     s: &mut PathState,
     med: &crate::medium::HomogeneousMedium,
-    p: Vec3,
+    seg: Segment,
     dim: u32,
 ) -> Option<ShadowRequest> {
+    let p = seg.ray.at(seg.t);
     if s.depth >= ctx.max_depth {
         s.alive = false;
         return None;
@@ -468,10 +532,15 @@ fn scatter_in_medium<const MOTION: bool>(
                 .sample::<MOTION>(prims, p, u_sel, u_l, s.time, ctx.textures)
         {
             let ph = med.phase(wo, ls.wi);
-            let w = if ls.delta {
-                1.0
-            } else {
-                power_heuristic(ls.pdf, ph)
+            let w = match ls.point {
+                // The equiangular technique also produces this point light's scattering:
+                // weight by the two distance densities.
+                Some((q, _)) if ls.delta && ctx.equiangular => {
+                    crate::medium::Equiangular::new(seg.ray.o, seg.ray.d, 0.0, seg.t_hit, q)
+                        .map_or(1.0, |eq| seg.p_ff / (seg.p_ff + eq.pdf(seg.t)))
+                }
+                _ if ls.delta => 1.0,
+                _ => power_heuristic(ls.pdf, ph),
             };
             let contrib = s.beta * ls.radiance * (ph * w / ls.pdf);
             if contrib != Vec3::ZERO && contrib.is_finite() {

@@ -20,7 +20,9 @@ pub fn render_tile<const MOTION: bool, const MEDIA: bool>(
             while s.alive {
                 let hit = ctx.scene.intersect::<MOTION>(&s.ray, f32::INFINITY, s.time);
                 stats.rays += 1;
-                if let Some(r) = shade::<MOTION, MEDIA>(ctx, &mut s, hit) {
+                let mut extra = None;
+                let first = shade::<MOTION, MEDIA>(ctx, &mut s, hit, &mut extra);
+                for r in [first, extra].into_iter().flatten() {
                     stats.shadow_rays += 1;
                     if MEDIA {
                         s.l += r.contrib

@@ -153,7 +153,9 @@ impl Queues {
         Self {
             rays: RayQueue::new(cap),
             hits: vec![None; cap],
-            shadow: ShadowQueue::new(cap),
+            // Up to two shadow rays per path step (light sampling, and in media the
+            // equiangular technique).
+            shadow: ShadowQueue::new(2 * cap),
         }
     }
 }
@@ -208,7 +210,11 @@ pub fn render_tile<const MOTION: bool, const MEDIA: bool>(
         q.shadow.len = 0;
         for i in 0..n {
             let mut s = q.rays.load(i);
-            if let Some(r) = shade::<MOTION, MEDIA>(ctx, &mut s, q.hits[i]) {
+            let mut extra = None;
+            if let Some(r) = shade::<MOTION, MEDIA>(ctx, &mut s, q.hits[i], &mut extra) {
+                q.shadow.push(&r, i, s.time);
+            }
+            if let Some(r) = extra {
                 q.shadow.push(&r, i, s.time);
             }
             q.rays.store(i, &s);

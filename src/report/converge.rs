@@ -61,6 +61,7 @@ pub const VARY_ALIASES: &[(&str, &str)] = &[
     ("wavelengths", "render.integrator.wavelengths"),
     ("sampler", "render.integrator.sampler"),
     ("newton_tolerance", "render.newton_tolerance"),
+    ("equiangular", "render.integrator.equiangular"),
 ];
 
 fn apply_knob(c: &mut Config, key: &str, value: &str) -> Result<(), String> {

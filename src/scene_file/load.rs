@@ -20,6 +20,7 @@ pub struct RenderSettings {
     pub fresnel: schema::Fresnel,
     pub wavelengths: u32,
     pub sampler: schema::SamplerChoice,
+    pub equiangular: bool,
 }
 
 /// A loaded scene: the world of entities and the resources beside it.
@@ -110,6 +111,7 @@ pub const OVERRIDE_KEYS: &[&str] = &[
     "render.integrator.fresnel",
     "render.integrator.wavelengths",
     "render.integrator.sampler",
+    "render.integrator.equiangular",
     "camera.position",
     "camera.look_at",
     "camera.up",
@@ -150,6 +152,7 @@ pub fn apply_override(scene: &mut schema::Scene, key: &str, value: &str) -> Resu
         "render.integrator.fresnel" => r.integrator.fresnel = val(key, value)?,
         "render.integrator.wavelengths" => r.integrator.wavelengths = val(key, value)?,
         "render.integrator.sampler" => r.integrator.sampler = val(key, value)?,
+        "render.integrator.equiangular" => r.integrator.equiangular = val(key, value)?,
         "camera.position" => c.position = val(key, value)?,
         "camera.look_at" => c.look_at = val(key, value)?,
         "camera.up" => c.up = val(key, value)?,
@@ -229,6 +232,7 @@ fn build_world(scene: schema::Scene, path: &Path, hash: u64) -> Result<LoadedSce
         fresnel: r.integrator.fresnel,
         wavelengths: r.integrator.wavelengths.0,
         sampler: r.integrator.sampler,
+        equiangular: r.integrator.equiangular,
     };
     let camera_path = scene.animation.as_ref().map(|a| CameraPath {
         fps: a.fps,

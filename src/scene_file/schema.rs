@@ -87,6 +87,14 @@ pub struct IntegratorSettings {
     pub wavelengths: Wavelengths,
     #[serde(default)]
     pub sampler: SamplerChoice,
+    /// In media, also sample scattering distances towards point and spot lights
+    /// (equiangular sampling, combined with free-flight sampling by MIS).
+    #[serde(default = "default_true")]
+    pub equiangular: bool,
+}
+
+fn default_true() -> bool {
+    true
 }
 
 fn default_rr_depth() -> u32 {
@@ -104,6 +112,7 @@ impl Default for IntegratorSettings {
             fresnel: Fresnel::default(),
             wavelengths: default_wavelengths(),
             sampler: SamplerChoice::default(),
+            equiangular: true,
         }
     }
 }

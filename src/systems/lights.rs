@@ -148,6 +148,20 @@ impl Lights {
         }
     }
 
+    /// Chooses a light exactly as `sample` does; returns it when it is a point or spot light
+    /// (the lights equiangular sampling aims at), with its selection probability.
+    #[inline]
+    pub fn pick_point(&self, u_select: f32) -> Option<(crate::components::PointLight, f32)> {
+        if self.lights.is_empty() {
+            return None;
+        }
+        let (i, pmf) = self.table.sample(u_select);
+        match self.lights[i] {
+            LightKind::Point(p) => Some((p, pmf)),
+            _ => None,
+        }
+    }
+
     /// Density of sampling direction `wi` towards the environment.
     #[inline]
     pub fn pdf_environment(&self) -> f32 {
