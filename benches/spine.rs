@@ -252,5 +252,38 @@ fn textures(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, kdtree, camera, integrator, effects, textures);
+/// The MEDIA effect's cost: the Cornell box filled with thin fog against the same box clear.
+fn media(c: &mut Criterion) {
+    let mut g = c.benchmark_group("media");
+    g.sample_size(10);
+    let dir = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let text = std::fs::read_to_string(dir.join("scenes/cornell.ron")).unwrap();
+    let fog = text.replacen(
+        "entities: [",
+        "entities: [\n        (name: \"fog\", shape: Box(min: (-1.0, -1.0, -1.0), max: (557.0, 550.0, 560.0)),\n         medium: (sigma_a: Rgb(0.0002, 0.0002, 0.0002), sigma_s: Rgb(0.001, 0.001, 0.001), g: 0.3)),",
+        1,
+    );
+    let opts = RenderOptions {
+        sample_offset: 0,
+        spp: 2,
+        time_limit: None,
+        integrator: Integrator::Wavefront,
+    };
+    for (name, t) in [("clear", &text), ("thin_fog", &fog)] {
+        let o = vec![
+            ("render.width".to_string(), "48".to_string()),
+            ("render.height".to_string(), "48".to_string()),
+        ];
+        let loaded = prism::scene_file::load_str(t, &dir.join("scenes/cornell.ron"), &o).unwrap();
+        let scene = prepare(&loaded, &KdParams::default());
+        g.bench_function(format!("cornell_48x48_2spp_{name}"), |b| {
+            b.iter(|| render(&scene, &opts, &|_| {}).stats.samples)
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(
+    benches, kdtree, camera, integrator, effects, textures, media
+);
 criterion_main!(benches);

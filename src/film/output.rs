@@ -202,7 +202,7 @@ pub(crate) fn label(path: Option<&Path>, fallback: &str) -> String {
 
 /// An OS error as a short lowercase phrase ("permission denied") that reads
 /// well after "cannot write 'x': "; the OS error number adds nothing there.
-fn io_reason(error: &io::Error) -> String {
+pub(crate) fn io_reason(error: &io::Error) -> String {
     let text = error.to_string();
     let text = match text.rfind(" (os error ") {
         Some(i) if text.ends_with(')') => &text[..i],

@@ -388,19 +388,7 @@ impl OrientedBox {
         let mut p = r.at(t);
         // The face is the one the point lies closest to, relative to the box size; snapping
         // the point onto it removes the error along the normal.
-        let size = (self.max - self.min).max(Vec3::splat(f32::MIN_POSITIVE));
-        let mut best = (f32::INFINITY, 0usize, 0.0f32, 1.0f32);
-        for a in 0..3 {
-            let dmin = (p[a] - self.min[a]).abs() / size[a];
-            let dmax = (p[a] - self.max[a]).abs() / size[a];
-            if dmin < best.0 {
-                best = (dmin, a, self.min[a], -1.0);
-            }
-            if dmax < best.0 {
-                best = (dmax, a, self.max[a], 1.0);
-            }
-        }
-        let (_, axis, plane, sign) = best;
+        let (axis, plane, sign) = self.face(p);
         p[axis] = plane;
         p = p.clamp(self.min, self.max);
         let mut n_obj = Vec3::ZERO;

@@ -85,19 +85,7 @@ impl TextureError {
     }
 }
 
-/// An OS error as a short lowercase phrase that reads well after "cannot read 'x': ".
-fn io_reason(error: &io::Error) -> String {
-    let text = error.to_string();
-    let text = match text.rfind(" (os error ") {
-        Some(i) if text.ends_with(')') => &text[..i],
-        _ => &text,
-    };
-    let mut chars = text.chars();
-    match chars.next() {
-        Some(first) => first.to_lowercase().chain(chars).collect(),
-        None => String::new(),
-    }
-}
+use crate::film::output::io_reason;
 
 /// A decoded texture: linear RGB, row-major, top row of the file first.
 ///
