@@ -234,19 +234,30 @@ pub fn render_tile<const MOTION: bool, const MEDIA: bool>(
             }
         }
         stats.shadow_rays += sh.len as u64;
-        // Stage 6, compact: finished paths go to the film, live ones move down in order.
-        let mut w = 0;
+        // Stage 6, compact: finished paths go to the film; each hole is filled from the live
+        // paths at the end of the queue, so only as many records move as paths finished.
         for i in 0..n {
-            if q.rays.alive[i] {
-                if w != i {
-                    let s = q.rays.load(i);
-                    q.rays.store(w, &s);
-                }
-                w += 1;
-            } else {
+            if !q.rays.alive[i] {
                 super::accumulate(film, tile, ctx.width, q.rays.pixel[i], q.rays.l[i], stats);
             }
         }
-        q.rays.len = w;
+        let (mut lo, mut hi) = (0, n);
+        loop {
+            while lo < hi && q.rays.alive[lo] {
+                lo += 1;
+            }
+            while hi > lo && !q.rays.alive[hi - 1] {
+                hi -= 1;
+            }
+            if lo >= hi {
+                break;
+            }
+            let s = q.rays.load(hi - 1);
+            q.rays.store(lo, &s);
+            q.rays.alive[hi - 1] = false;
+            lo += 1;
+            hi -= 1;
+        }
+        q.rays.len = lo;
     }
 }
