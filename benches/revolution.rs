@@ -9,18 +9,7 @@ use prism::kdtree::{KdParams, KdTree};
 use prism::sampling::{Sampler, SamplerKind, square_to_uniform_sphere};
 use std::hint::black_box;
 
-const GOBLET: [(f32, f32); 10] = [
-    (0.0, 0.0),
-    (0.45, 0.0),
-    (0.45, 0.05),
-    (0.06, 0.1),
-    (0.05, 0.6),
-    (0.4, 0.9),
-    (0.5, 1.4),
-    (0.47, 1.4),
-    (0.37, 0.95),
-    (0.0, 0.7),
-];
+use prism::geometry::revolution::GOBLET_PROFILE as GOBLET;
 
 const RAYS: u32 = 4096;
 

@@ -23,6 +23,28 @@ fn cornell(size: u32, spp: u32) -> RenderScene {
     )
 }
 
+/// Scene text prepared for rendering at `w`×`h` (the path resolves relative assets).
+fn scene_text(text: &str, path: &Path, w: u32, h: u32) -> RenderScene {
+    let o = vec![
+        ("render.width".to_string(), w.to_string()),
+        ("render.height".to_string(), h.to_string()),
+    ];
+    prepare(
+        &prism::scene_file::load_str(text, path, &o).unwrap(),
+        &KdParams::default(),
+    )
+}
+
+/// Wavefront render options for `spp` samples per pixel.
+fn wavefront(spp: u32) -> RenderOptions {
+    RenderOptions {
+        sample_offset: 0,
+        spp,
+        time_limit: None,
+        integrator: Integrator::Wavefront,
+    }
+}
+
 fn random_boxes(n: usize) -> Vec<Aabb> {
     let s = Sampler::new(SamplerKind::Independent, 1);
     (0..n as u32)
@@ -137,20 +159,8 @@ fn integrator(c: &mut Criterion) {
         "motion_blur.ron still has the motions this bench removes"
     );
     for (name, t) in [("motion_blur", &text), ("motion_blur_static", &still)] {
-        let o = vec![
-            ("render.width".to_string(), "64".to_string()),
-            ("render.height".to_string(), "36".to_string()),
-            ("render.spp".to_string(), "4".to_string()),
-        ];
-        let loaded =
-            prism::scene_file::load_str(t, Path::new("scenes/motion_blur.ron"), &o).unwrap();
-        let scene = prepare(&loaded, &KdParams::default());
-        let opts = RenderOptions {
-            sample_offset: 0,
-            spp: 4,
-            time_limit: None,
-            integrator: Integrator::Wavefront,
-        };
+        let scene = scene_text(t, Path::new("scenes/motion_blur.ron"), 64, 36);
+        let opts = wavefront(4);
         g.bench_function(format!("{name}_64x36_4spp"), |b| {
             b.iter(|| render(&scene, &opts, &|_| {}).stats.samples)
         });
@@ -164,12 +174,7 @@ fn effects(c: &mut Criterion) {
     use prism::systems::Effect;
     let mut g = c.benchmark_group("effects");
     g.sample_size(10);
-    let opts = RenderOptions {
-        sample_offset: 0,
-        spp: 2,
-        time_limit: None,
-        integrator: Integrator::Wavefront,
-    };
+    let opts = wavefront(2);
     let sets: [(&str, &[Effect]); 4] = [
         ("none", &[]),
         ("lens", &[Effect::Lens]),
@@ -233,18 +238,8 @@ fn textures(c: &mut Criterion) {
             "material: Diffuse(albedo: Rgb(1.0, 1.0, 1.0))),",
         );
     for (name, t) in [("textured", &text), ("untextured", &plain)] {
-        let o = vec![
-            ("render.width".to_string(), "64".to_string()),
-            ("render.height".to_string(), "48".to_string()),
-        ];
-        let loaded = prism::scene_file::load_str(t, &dir.join("scenes/textures.ron"), &o).unwrap();
-        let scene = prepare(&loaded, &KdParams::default());
-        let opts = RenderOptions {
-            sample_offset: 0,
-            spp: 4,
-            time_limit: None,
-            integrator: Integrator::Wavefront,
-        };
+        let scene = scene_text(t, &dir.join("scenes/textures.ron"), 64, 48);
+        let opts = wavefront(4);
         g.bench_function(format!("pass_{name}_64x48_4spp"), |b| {
             b.iter(|| render(&scene, &opts, &|_| {}).stats.samples)
         });
@@ -263,19 +258,9 @@ fn media(c: &mut Criterion) {
         "entities: [\n        (name: \"fog\", shape: Box(min: (-1.0, -1.0, -1.0), max: (557.0, 550.0, 560.0)),\n         medium: (sigma_a: Rgb(0.0002, 0.0002, 0.0002), sigma_s: Rgb(0.001, 0.001, 0.001), g: 0.3)),",
         1,
     );
-    let opts = RenderOptions {
-        sample_offset: 0,
-        spp: 2,
-        time_limit: None,
-        integrator: Integrator::Wavefront,
-    };
+    let opts = wavefront(2);
     for (name, t) in [("clear", &text), ("thin_fog", &fog)] {
-        let o = vec![
-            ("render.width".to_string(), "48".to_string()),
-            ("render.height".to_string(), "48".to_string()),
-        ];
-        let loaded = prism::scene_file::load_str(t, &dir.join("scenes/cornell.ron"), &o).unwrap();
-        let scene = prepare(&loaded, &KdParams::default());
+        let scene = scene_text(t, &dir.join("scenes/cornell.ron"), 48, 48);
         g.bench_function(format!("cornell_48x48_2spp_{name}"), |b| {
             b.iter(|| render(&scene, &opts, &|_| {}).stats.samples)
         });

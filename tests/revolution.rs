@@ -8,18 +8,7 @@ use glam::{DVec3, Vec3};
 use prism::geometry::revolution::{DEFAULT_TOLERANCE, Revolution, RevolutionHit, RevolutionStats};
 use prism::geometry::{Ray, offset_ray_origin};
 
-const GOBLET: [(f32, f32); 10] = [
-    (0.0, 0.0),
-    (0.45, 0.0),
-    (0.45, 0.05),
-    (0.06, 0.1),
-    (0.05, 0.6),
-    (0.4, 0.9),
-    (0.5, 1.4),
-    (0.47, 1.4),
-    (0.37, 0.95),
-    (0.0, 0.7),
-];
+use prism::geometry::revolution::GOBLET_PROFILE as GOBLET;
 
 /// An open sheet: neither end on the axis; it bulges, pinches and flares.
 const VASE: [(f32, f32); 6] = [

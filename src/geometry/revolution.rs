@@ -438,6 +438,21 @@ struct FlatIv {
     r: [f64; 4],
 }
 
+/// The seed's goblet: a thick, closed profile (outer wall up, rim, inner wall down), as in
+/// `scenes/goblet.ron`; shared by the tests and benches.
+pub const GOBLET_PROFILE: [(f32, f32); 10] = [
+    (0.0, 0.0),
+    (0.45, 0.0),
+    (0.45, 0.05),
+    (0.06, 0.1),
+    (0.05, 0.6),
+    (0.4, 0.9),
+    (0.5, 1.4),
+    (0.47, 1.4),
+    (0.37, 0.95),
+    (0.0, 0.7),
+];
+
 /// A surface of revolution in object space (the profile revolved about y).
 #[derive(Clone, Debug)]
 pub struct Revolution {
