@@ -92,7 +92,7 @@ fn camera_rays<const MOTION: bool>(ctx: &Ctx) -> Vec2 {
     let mut acc = Vec2::ZERO;
     for y in 0..64 {
         for x in 0..64 {
-            let s = camera_ray::<MOTION>(ctx, x, y, 0);
+            let s = camera_ray::<prism::integrator::transport::Rgb, MOTION>(ctx, x, y, 0);
             acc += s.ray.d.truncate() + s.time;
         }
     }

@@ -146,18 +146,44 @@ fn missing_scene_file_names_the_path() {
 }
 
 #[test]
-fn unsupported_features_are_refused_not_ignored() {
+fn bad_values_are_refused_with_their_valid_range() {
     let d = tempfile::tempdir().unwrap();
-    let scene = write(
-        d.path(),
-        "s.ron",
-        &GOOD.replace(
-            "material: Diffuse(albedo: Rgb(0.5, 0.5, 0.5))",
-            "material: Dielectric(ior: Cauchy(a: 1.5, b: 0.004))",
-        ),
+    let with = |name: &str, material: &str| {
+        write(
+            d.path(),
+            name,
+            &GOOD.replace("material: Diffuse(albedo: Rgb(0.5, 0.5, 0.5))", material),
+        )
+    };
+    // A Cauchy IOR below 1 somewhere in 360–830 nm.
+    let scene = with(
+        "c.ron",
+        "material: Dielectric(ior: Cauchy(a: 0.9, b: 0.004))",
     );
     let err = fails(&["render", scene.to_str().unwrap()]);
-    assert!(err.contains("spectral"), "{err}");
+    assert!(
+        err.contains(">= 1") && err.contains("nm") && err.contains(":"),
+        "{err}"
+    );
+    // A Sellmeier resonance at 500 nm, inside the simulated range.
+    let scene = with(
+        "s.ron",
+        "material: Dielectric(ior: Sellmeier(b: (1.0, 0.0, 0.0), c: (0.25, 0.0, 0.0)))",
+    );
+    let err = fails(&["render", scene.to_str().unwrap()]);
+    assert!(err.contains("resonance at 500 nm"), "{err}");
+    let scene = with(
+        "b.ron",
+        "material: Light(emission: Blackbody(kelvin: 20.0, scale: 1.0))",
+    );
+    let err = fails(&["render", scene.to_str().unwrap()]);
+    assert!(
+        err.contains("kelvin") && err.contains("500..=100000"),
+        "{err}"
+    );
+    let scene = with("p.ron", "material: Dielectric(ior: Preset(Glass))");
+    let err = fails(&["render", scene.to_str().unwrap()]);
+    assert!(err.contains("Bk7") && err.contains("Diamond"), "{err}");
     let err = fails(&[
         "render",
         write(d.path(), "g.ron", GOOD).to_str().unwrap(),

@@ -20,7 +20,9 @@ pub struct PointLight {
     pub position: Vec3,
     /// Spot axis (unused by a point light).
     pub direction: Vec3,
+    /// Linear sRGB intensity; `spectrum` is what spectral transport evaluates.
     pub intensity: Vec3,
+    pub spectrum: crate::spectrum::EmitterSpectrum,
     /// Cosine of the cone half-angle: −1 for an omnidirectional point light.
     pub cos_cone: f32,
     /// Cosine where the soft edge starts.
@@ -34,14 +36,23 @@ impl PointLight {
         if self.cos_cone <= -1.0 {
             return self.intensity;
         }
+        self.intensity * self.falloff(w)
+    }
+
+    /// The spot's angular factor in [0, 1] towards unit direction `w` (1 for a point light).
+    #[inline]
+    pub fn falloff(&self, w: Vec3) -> f32 {
+        if self.cos_cone <= -1.0 {
+            return 1.0;
+        }
         let c = w.dot(self.direction);
         if c >= self.cos_falloff_start {
-            self.intensity
+            1.0
         } else if c <= self.cos_cone {
-            Vec3::ZERO
+            0.0
         } else {
             let x = (c - self.cos_cone) / (self.cos_falloff_start - self.cos_cone);
-            self.intensity * (x * x * (3.0 - 2.0 * x))
+            x * x * (3.0 - 2.0 * x)
         }
     }
 

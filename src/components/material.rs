@@ -14,6 +14,7 @@
 //! A `Light` emits from the side its normal faces (spheres and boxes: outward) unless
 //! `two_sided`; it does not scatter.
 
+use crate::spectrum::{EmitterSpectrum, IorModel};
 use glam::Vec3;
 
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -22,10 +23,16 @@ pub enum Material {
     Diffuse { albedo: Vec3 },
     /// Perfect specular reflection.
     Mirror { tint: Vec3 },
-    /// Smooth glass: Fresnel-weighted reflection and refraction.
-    Dielectric { ior: f32 },
-    /// An area emitter of constant radiance.
-    Light { emission: Vec3, two_sided: bool },
+    /// Smooth glass: Fresnel-weighted reflection and refraction. A wavelength-dependent IOR
+    /// disperses light (spectral transport only).
+    Dielectric { ior: IorModel },
+    /// An area emitter of constant radiance: `emission` is its linear sRGB colour, `spectrum`
+    /// what spectral transport evaluates.
+    Light {
+        emission: Vec3,
+        two_sided: bool,
+        spectrum: EmitterSpectrum,
+    },
     /// No surface at all: the boundary of a medium, crossed without scattering.
     Boundary,
 }
@@ -41,9 +48,11 @@ impl Material {
             Material::Light {
                 emission,
                 two_sided,
+                spectrum,
             } => Material::Light {
                 emission: emission * a,
                 two_sided,
+                spectrum,
             },
             m @ (Material::Dielectric { .. } | Material::Boundary) => m,
         }

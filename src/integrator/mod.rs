@@ -8,6 +8,7 @@
 pub mod bsdf;
 pub mod path;
 pub mod reference;
+pub mod transport;
 pub mod wavefront;
 
 use crate::systems::{Effect, RenderScene};
@@ -108,7 +109,27 @@ pub(crate) fn accumulate(
 thread_local! {
     // Each worker thread allocates its queues once and reuses them for every tile, pass and
     // render (rayon's `map_init` would build them again for every split of the work).
-    static QUEUES: std::cell::RefCell<wavefront::Queues> = std::cell::RefCell::new(wavefront::Queues::default());
+    static QUEUES_RGB: std::cell::RefCell<wavefront::Queues<transport::Rgb>> =
+        std::cell::RefCell::new(wavefront::Queues::default());
+    static QUEUES_SPECTRAL: std::cell::RefCell<wavefront::Queues<transport::Spectral>> =
+        std::cell::RefCell::new(wavefront::Queues::default());
+}
+
+/// This thread's reusable queues for a transport.
+trait WithQueues: transport::Transport {
+    fn with_queues<R>(f: impl FnOnce(&mut wavefront::Queues<Self>) -> R) -> R;
+}
+
+impl WithQueues for transport::Rgb {
+    fn with_queues<R>(f: impl FnOnce(&mut wavefront::Queues<Self>) -> R) -> R {
+        QUEUES_RGB.with_borrow_mut(f)
+    }
+}
+
+impl WithQueues for transport::Spectral {
+    fn with_queues<R>(f: impl FnOnce(&mut wavefront::Queues<Self>) -> R) -> R {
+        QUEUES_SPECTRAL.with_borrow_mut(f)
+    }
 }
 
 /// Which integrator runs the passes.
@@ -170,24 +191,30 @@ pub fn render(
         fx.has(Effect::Motion),
     );
     // One dispatch per render into the variant for this effect set.
+    use transport::{Rgb, Spectral};
     match (s, m, mo) {
-        (false, false, false) => render_with::<false, false, false>(scene, opts, progress),
-        (false, false, true) => render_with::<false, false, true>(scene, opts, progress),
-        (false, true, false) => render_with::<false, true, false>(scene, opts, progress),
-        (false, true, true) => render_with::<false, true, true>(scene, opts, progress),
-        (true, false, false) => render_with::<true, false, false>(scene, opts, progress),
-        (true, false, true) => render_with::<true, false, true>(scene, opts, progress),
-        (true, true, false) => render_with::<true, true, false>(scene, opts, progress),
-        (true, true, true) => render_with::<true, true, true>(scene, opts, progress),
+        (false, false, false) => render_with::<Rgb, false, false>(scene, opts, progress),
+        (false, false, true) => render_with::<Rgb, false, true>(scene, opts, progress),
+        (false, true, false) => render_with::<Rgb, true, false>(scene, opts, progress),
+        (false, true, true) => render_with::<Rgb, true, true>(scene, opts, progress),
+        (true, false, false) => render_with::<Spectral, false, false>(scene, opts, progress),
+        (true, false, true) => render_with::<Spectral, false, true>(scene, opts, progress),
+        (true, true, false) => render_with::<Spectral, true, false>(scene, opts, progress),
+        (true, true, true) => render_with::<Spectral, true, true>(scene, opts, progress),
     }
 }
 
-fn render_with<const SPECTRAL: bool, const MEDIA: bool, const MOTION: bool>(
+fn render_with<T: WithQueues, const MEDIA: bool, const MOTION: bool>(
     scene: &RenderScene,
     opts: &RenderOptions,
     progress: &(dyn Fn(u64) + Sync),
 ) -> RenderOutput {
-    let ctx = Ctx::new(scene, scene.effects.has(Effect::Lens));
+    let spectral = if scene.effects.has(Effect::Spectral) {
+        transport::SpectralData::new(scene)
+    } else {
+        transport::SpectralData::EMPTY
+    };
+    let ctx = Ctx::new(scene, scene.effects.has(Effect::Lens)).with_spectral(&spectral);
     let (w, h) = (scene.settings.width, scene.settings.height);
     let tiles = tiles(w, h);
     let mut sums = vec![[0.0f64; 3]; (w * h) as usize];
@@ -211,8 +238,8 @@ fn render_with<const SPECTRAL: bool, const MEDIA: bool, const MOTION: bool>(
                 let mut film = vec![[0.0f64; 3]; tile.pixels()];
                 let mut st = RenderStats::default();
                 match opts.integrator {
-                    Integrator::Wavefront => QUEUES.with_borrow_mut(|q| {
-                        wavefront::render_tile::<MOTION, MEDIA>(
+                    Integrator::Wavefront => T::with_queues(|q| {
+                        wavefront::render_tile::<T, MOTION, MEDIA>(
                             &ctx,
                             q,
                             tile,
@@ -222,7 +249,7 @@ fn render_with<const SPECTRAL: bool, const MEDIA: bool, const MOTION: bool>(
                             &mut st,
                         )
                     }),
-                    Integrator::Reference => reference::render_tile::<MOTION, MEDIA>(
+                    Integrator::Reference => reference::render_tile::<T, MOTION, MEDIA>(
                         &ctx,
                         tile,
                         s0,
@@ -257,7 +284,6 @@ fn render_with<const SPECTRAL: bool, const MEDIA: bool, const MOTION: bool>(
             pass *= 2;
         }
     }
-    let _ = SPECTRAL;
     RenderOutput {
         width: w,
         height: h,

@@ -2,11 +2,13 @@
 //! stages and the reference integrator, so both simulate exactly the same physics.
 
 use super::bsdf::{fresnel_dielectric, fresnel_schlick, reflect, refract};
+use super::transport::{MediumOps, SpectralData, Transport};
 use crate::components::Material;
 use crate::geometry::{Ray, offset_ray_origin, spawn_ray_to};
 use crate::medium::DistanceSample;
 use crate::sampling::{self, Sampler};
 use crate::scene_file::schema::{Fresnel, LightSampling};
+use crate::spectrum::Channels;
 use crate::systems::primitives::NO_MEDIUM;
 use crate::systems::{Hit, RenderScene, primitives::emitted};
 use glam::{Vec2, Vec3};
@@ -44,7 +46,13 @@ pub struct Ctx<'a> {
     pub textures: bool,
     pub normal_maps: bool,
     pub equiangular: bool,
+    /// Spectral forms of the scene's colours (empty in RGB transport).
+    pub spectral: &'a SpectralData,
+    /// One wavelength per path instead of four (`render.integrator.wavelengths: 1`).
+    pub single_wavelength: bool,
 }
+
+static NO_SPECTRAL_DATA: SpectralData = SpectralData::EMPTY;
 
 impl<'a> Ctx<'a> {
     pub fn new(scene: &'a RenderScene, lens: bool) -> Self {
@@ -69,17 +77,26 @@ impl<'a> Ctx<'a> {
             textures: scene.effects.has(crate::systems::Effect::Textures),
             normal_maps: scene.effects.has(crate::systems::Effect::NormalMaps),
             equiangular: s.equiangular,
+            spectral: &NO_SPECTRAL_DATA,
+            single_wavelength: s.wavelengths == 1,
         }
+    }
+
+    /// The same constants with the spectral data spectral transport reads.
+    pub fn with_spectral(self, spectral: &'a SpectralData) -> Self {
+        Ctx { spectral, ..self }
     }
 }
 
 /// The state a path carries between vertices.
 #[derive(Clone, Copy, Debug)]
-pub struct PathState {
+pub struct PathState<T: Transport> {
     pub ray: Ray,
-    pub beta: Vec3,
+    pub beta: T::S,
     /// Radiance gathered so far.
-    pub l: Vec3,
+    pub l: T::S,
+    /// The path's wavelengths (spectral transport).
+    pub lambda: T::Lambda,
     /// Product of squared relative IORs crossed; Russian roulette divides it out of the
     /// throughput so entering dense glass does not kill paths.
     pub eta_scale: f32,
@@ -101,10 +118,10 @@ pub struct PathState {
 /// A shadow ray whose contribution lands on the path if nothing blocks it (with MEDIA, scaled
 /// by the transmittance along it, starting in `medium`).
 #[derive(Clone, Copy, Debug)]
-pub struct ShadowRequest {
+pub struct ShadowRequest<S> {
     pub ray: Ray,
     pub t_max: f32,
-    pub contrib: Vec3,
+    pub contrib: S,
     pub medium: u32,
 }
 
@@ -118,7 +135,12 @@ fn power_heuristic(a: f32, b: f32) -> f32 {
 /// a tent filter of radius one pixel, a lens position when the LENS effect is on, a time when
 /// MOTION is on.
 #[inline]
-pub fn camera_ray<const MOTION: bool>(ctx: &Ctx, x: u32, y: u32, index: u32) -> PathState {
+pub fn camera_ray<T: Transport, const MOTION: bool>(
+    ctx: &Ctx,
+    x: u32,
+    y: u32,
+    index: u32,
+) -> PathState<T> {
     let pixel = y * ctx.width + x;
     let time = if MOTION {
         let (open, close) = ctx.scene.shutter;
@@ -158,10 +180,12 @@ pub fn camera_ray<const MOTION: bool>(ctx: &Ctx, x: u32, y: u32, index: u32) -> 
         let focus = cam.origin + dir * cam.focus_distance;
         ray = Ray::new(o, (focus - o).normalize());
     }
+    let lambda = T::wavelengths(ctx, pixel, index);
     PathState {
         ray,
-        beta: Vec3::ONE,
-        l: Vec3::ZERO,
+        beta: T::initial_beta(&lambda),
+        l: T::S::ZERO,
+        lambda,
         eta_scale: 1.0,
         depth: 0,
         specular: false,
@@ -222,17 +246,17 @@ fn below(wt: Vec3, n: Vec3) -> Vec3 {
 #[inline]
 ///
 /// In a medium, a second shadow ray may come back in `extra`: the equiangular technique's.
-pub fn shade<const MOTION: bool, const MEDIA: bool>(
+pub fn shade<T: Transport, const MOTION: bool, const MEDIA: bool>(
     ctx: &Ctx,
-    s: &mut PathState,
+    s: &mut PathState<T>,
     hit: Option<Hit>,
-    extra: &mut Option<ShadowRequest>,
-) -> Option<ShadowRequest> {
+    extra: &mut Option<ShadowRequest<T::S>>,
+) -> Option<ShadowRequest<T::S>> {
     let scene = ctx.scene;
     let lights = &scene.lights;
     let wo = -s.ray.d;
     if MEDIA && s.medium != NO_MEDIUM {
-        let med = scene.prims.media[s.medium as usize];
+        let med = T::medium(ctx, s.medium, &s.lambda);
         let dim = DIM_MEDIA + s.segments * DIMS_PER_SEGMENT;
         s.segments += 1;
         let (pixel, index) = (s.pixel, s.sample);
@@ -241,7 +265,7 @@ pub fn shade<const MOTION: bool, const MEDIA: bool>(
         let u_t = ctx.sampler.get_1d(pixel, index, dim + 1);
         let probs = s.beta;
         if ctx.equiangular && ctx.nee && s.depth < ctx.max_depth {
-            *extra = equiangular_nee(ctx, s, &med, t_hit, dim);
+            *extra = equiangular_nee::<T>(ctx, s, &med, t_hit, dim);
         }
         match med.sample_distance(t_hit, u_c, u_t, probs) {
             DistanceSample::Pass { weight } => s.beta *= weight,
@@ -253,15 +277,15 @@ pub fn shade<const MOTION: bool, const MEDIA: bool>(
                     t_hit,
                     p_ff: med.distance_pdf(t, probs),
                 };
-                return scatter_in_medium::<MOTION>(ctx, s, &med, seg, dim);
+                return scatter_in_medium::<T, MOTION>(ctx, s, &med, seg, dim);
             }
         }
-        if s.beta == Vec3::ZERO {
+        if s.beta == T::S::ZERO {
             s.alive = false;
             return None;
         }
     }
-    let mis_emitter = |s: &PathState, pdf_light: f32| -> f32 {
+    let mis_emitter = |s: &PathState<T>, pdf_light: f32| -> f32 {
         if s.depth == 0 || s.specular || !ctx.nee {
             1.0
         } else {
@@ -271,14 +295,16 @@ pub fn shade<const MOTION: bool, const MEDIA: bool>(
     let Some(hit) = hit else {
         if scene.environment != Vec3::ZERO {
             let w = mis_emitter(s, lights.pdf_environment());
-            s.l += s.beta * scene.environment * w;
+            s.l += s.beta * T::environment(ctx, &s.lambda) * w;
         }
         s.alive = false;
         return None;
     };
     let prims = &scene.prims;
     let mut sp = prims.surface_at::<MOTION>(&s.ray, &hit, s.time);
-    let mut material = prims.materials[prims.material[hit.prim as usize] as usize];
+    let mat = prims.material[hit.prim as usize];
+    let mut material = prims.materials[mat as usize];
+    let mut tex_albedo = None;
     if (ctx.textures || ctx.normal_maps)
         && let Some(tex) = prims.texture_of(hit.prim)
     {
@@ -287,6 +313,7 @@ pub fn shade<const MOTION: bool, const MEDIA: bool>(
             && let Some(a) = tex.albedo(uv)
         {
             material = material.modulated(a);
+            tex_albedo = Some(a);
         }
         if ctx.normal_maps && tex.normal_map.is_some() {
             // As pbrt does: the perturbed normal is turned to the geometric normal's side;
@@ -312,7 +339,7 @@ pub fn shade<const MOTION: bool, const MEDIA: bool>(
                     lights.pdf_area::<MOTION>(prims, hit.prim, s.prev_p, sp.p, sp.n, s.time),
                 )
             };
-            s.l += s.beta * le * w;
+            s.l += s.beta * T::emission(ctx, mat, le, tex_albedo, &s.lambda) * w;
         }
         // Emitters absorb what they do not emit.
         s.alive = false;
@@ -342,14 +369,17 @@ pub fn shade<const MOTION: bool, const MEDIA: bool>(
                     let cos = ls.wi.dot(nsf);
                     if cos > 0.0 && ls.wi.dot(nf) > 0.0 {
                         let bsdf_pdf = cos * std::f32::consts::FRAC_1_PI;
-                        let f = albedo * std::f32::consts::FRAC_1_PI * cos;
+                        let f = T::reflectance(ctx, mat, albedo, tex_albedo.is_some(), &s.lambda)
+                            * std::f32::consts::FRAC_1_PI
+                            * cos;
                         let w = if ls.delta {
                             1.0
                         } else {
                             power_heuristic(ls.pdf, bsdf_pdf)
                         };
-                        let contrib = s.beta * f * ls.radiance * (w / ls.pdf);
-                        if contrib != Vec3::ZERO {
+                        let contrib =
+                            s.beta * f * T::light_radiance(ctx, &ls, &s.lambda) * (w / ls.pdf);
+                        if contrib != T::S::ZERO {
                             let (ray, t_max) = match ls.point {
                                 // A point light sits on no surface: stop just short of it.
                                 Some((q, _)) if ls.delta => (
@@ -384,13 +414,13 @@ pub fn shade<const MOTION: bool, const MEDIA: bool>(
                 s.alive = false;
                 return shadow;
             }
-            s.beta *= albedo;
+            s.beta *= T::reflectance(ctx, mat, albedo, tex_albedo.is_some(), &s.lambda);
             s.prev_pdf = sampling::cosine_hemisphere_pdf(local.z);
             s.specular = false;
             s.ray = Ray::new(offset_ray_origin(sp.p, nf), wi);
         }
         Material::Mirror { tint } => {
-            s.beta *= tint;
+            s.beta *= T::reflectance(ctx, mat, tint, tex_albedo.is_some(), &s.lambda);
             s.specular = true;
             s.ray = Ray::new(
                 offset_ray_origin(sp.p, nf),
@@ -399,7 +429,8 @@ pub fn shade<const MOTION: bool, const MEDIA: bool>(
         }
         Material::Dielectric { ior } => {
             // The geometric normal points out of a closed shape: entering on its front.
-            let eta = if sp.front { ior } else { 1.0 / ior };
+            let n = T::eta(&ior, &mut s.lambda, &mut s.beta);
+            let eta = if sp.front { n } else { 1.0 / n };
             let cos_i = wo.dot(nsf).max(0.0);
             let r = if ctx.schlick {
                 fresnel_schlick(cos_i, eta)
@@ -439,7 +470,7 @@ pub fn shade<const MOTION: bool, const MEDIA: bool>(
 
 /// Russian roulette on the throughput with the IOR compression removed.
 #[inline]
-fn russian_roulette(ctx: &Ctx, s: &mut PathState, dim: u32) {
+fn russian_roulette<T: Transport>(ctx: &Ctx, s: &mut PathState<T>, dim: u32) {
     if s.depth >= ctx.rr_depth {
         let rr = (s.beta * s.eta_scale).max_element();
         if rr < 1.0 {
@@ -451,7 +482,7 @@ fn russian_roulette(ctx: &Ctx, s: &mut PathState, dim: u32) {
             s.beta /= 1.0 - q;
         }
     }
-    if s.beta == Vec3::ZERO {
+    if s.beta == T::S::ZERO {
         s.alive = false;
     }
 }
@@ -469,15 +500,15 @@ struct Segment {
 /// towards a chosen point or spot light, whose single-scattering contribution is combined with
 /// free-flight sampling's by the balance heuristic over the two distance densities.
 #[inline]
-fn equiangular_nee(
+fn equiangular_nee<T: Transport>(
     ctx: &Ctx,
-    s: &PathState,
-    med: &crate::medium::HomogeneousMedium,
+    s: &PathState<T>,
+    med: &T::Med,
     t_hit: f32,
     dim: u32,
-) -> Option<ShadowRequest> {
+) -> Option<ShadowRequest<T::S>> {
     let (pixel, index) = (s.pixel, s.sample);
-    let (pl, pmf) = ctx
+    let (li, pl, pmf) = ctx
         .scene
         .lights
         .pick_point(ctx.sampler.get_1d(pixel, index, dim + 8))?;
@@ -487,14 +518,14 @@ fn equiangular_nee(
     let d = pl.position - x;
     let d2 = d.length_squared();
     let wi = d / d2.sqrt();
-    let radiance = pl.intensity_towards(-wi) / d2;
+    let radiance = T::point_radiance(ctx, li, pl.intensity, pl.falloff(-wi) / d2, &s.lambda);
     let p_ff = med.distance_pdf(t, s.beta);
     let contrib = s.beta
-        * med.sigma_s
+        * med.sigma_s()
         * med.transmittance(t)
         * radiance
         * (med.phase(-s.ray.d, wi) / (pmf * (p_eq + p_ff)));
-    (contrib != Vec3::ZERO && contrib.is_finite()).then_some(ShadowRequest {
+    (contrib != T::S::ZERO && contrib.is_finite()).then_some(ShadowRequest {
         ray: Ray::new(x, d),
         t_max: 1.0 - 1e-4,
         contrib,
@@ -506,13 +537,13 @@ fn equiangular_nee(
 /// (MIS with phase sampling; for point and spot lights, balance-heuristic MIS with the
 /// equiangular technique), then a phase-sampled continuation.
 #[inline]
-fn scatter_in_medium<const MOTION: bool>(
+fn scatter_in_medium<T: Transport, const MOTION: bool>(
     ctx: &Ctx,
-    s: &mut PathState,
-    med: &crate::medium::HomogeneousMedium,
+    s: &mut PathState<T>,
+    med: &T::Med,
     seg: Segment,
     dim: u32,
-) -> Option<ShadowRequest> {
+) -> Option<ShadowRequest<T::S>> {
     let p = seg.ray.at(seg.t);
     if s.depth >= ctx.max_depth {
         s.alive = false;
@@ -542,8 +573,8 @@ fn scatter_in_medium<const MOTION: bool>(
                 _ if ls.delta => 1.0,
                 _ => power_heuristic(ls.pdf, ph),
             };
-            let contrib = s.beta * ls.radiance * (ph * w / ls.pdf);
-            if contrib != Vec3::ZERO && contrib.is_finite() {
+            let contrib = s.beta * T::light_radiance(ctx, &ls, &s.lambda) * (ph * w / ls.pdf);
+            if contrib != T::S::ZERO && contrib.is_finite() {
                 // A point in a medium lies on no surface: no offset at this end.
                 let (ray, t_max) = match ls.point {
                     Some((q, _)) if ls.delta => (Ray::new(p, q - p), 1.0 - 1e-4),

@@ -7,18 +7,21 @@
 //! Queues are allocated once per worker and reused for every tile: no allocation per ray.
 
 use super::path::{Ctx, PathState, ShadowRequest, camera_ray, shade};
+use super::transport::{MediumOps, Transport};
 use super::{RenderStats, Tile};
 use crate::geometry::Ray;
+use crate::spectrum::Channels;
 use crate::systems::Hit;
 use glam::Vec3;
 
 /// Live path records, one field per array.
-pub struct RayQueue {
+pub struct RayQueue<T: Transport> {
     len: usize,
     o: Vec<Vec3>,
     d: Vec<Vec3>,
-    beta: Vec<Vec3>,
-    l: Vec<Vec3>,
+    beta: Vec<T::S>,
+    l: Vec<T::S>,
+    lambda: Vec<T::Lambda>,
     eta_scale: Vec<f32>,
     depth: Vec<u32>,
     specular: Vec<bool>,
@@ -32,14 +35,15 @@ pub struct RayQueue {
     segments: Vec<u32>,
 }
 
-impl RayQueue {
+impl<T: Transport> RayQueue<T> {
     fn new(cap: usize) -> Self {
         Self {
             len: 0,
             o: vec![Vec3::ZERO; cap],
             d: vec![Vec3::ZERO; cap],
-            beta: vec![Vec3::ZERO; cap],
-            l: vec![Vec3::ZERO; cap],
+            beta: vec![T::S::ZERO; cap],
+            l: vec![T::S::ZERO; cap],
+            lambda: vec![T::Lambda::default(); cap],
             eta_scale: vec![0.0; cap],
             depth: vec![0; cap],
             specular: vec![false; cap],
@@ -59,11 +63,12 @@ impl RayQueue {
     }
 
     #[inline]
-    fn load(&self, i: usize) -> PathState {
+    fn load(&self, i: usize) -> PathState<T> {
         PathState {
             ray: Ray::new(self.o[i], self.d[i]),
             beta: self.beta[i],
             l: self.l[i],
+            lambda: self.lambda[i],
             eta_scale: self.eta_scale[i],
             depth: self.depth[i],
             specular: self.specular[i],
@@ -79,11 +84,12 @@ impl RayQueue {
     }
 
     #[inline]
-    fn store(&mut self, i: usize, s: &PathState) {
+    fn store(&mut self, i: usize, s: &PathState<T>) {
         self.o[i] = s.ray.o;
         self.d[i] = s.ray.d;
         self.beta[i] = s.beta;
         self.l[i] = s.l;
+        self.lambda[i] = s.lambda;
         self.eta_scale[i] = s.eta_scale;
         self.depth[i] = s.depth;
         self.specular[i] = s.specular;
@@ -99,18 +105,18 @@ impl RayQueue {
 }
 
 /// Shadow rays of the current step and the path slot each one serves.
-struct ShadowQueue {
+struct ShadowQueue<S> {
     len: usize,
     o: Vec<Vec3>,
     d: Vec<Vec3>,
     t_max: Vec<f32>,
     time: Vec<f32>,
-    contrib: Vec<Vec3>,
+    contrib: Vec<S>,
     medium: Vec<u32>,
     slot: Vec<u32>,
 }
 
-impl ShadowQueue {
+impl<S: Channels> ShadowQueue<S> {
     fn new(cap: usize) -> Self {
         Self {
             len: 0,
@@ -118,14 +124,14 @@ impl ShadowQueue {
             d: vec![Vec3::ZERO; cap],
             t_max: vec![0.0; cap],
             time: vec![0.0; cap],
-            contrib: vec![Vec3::ZERO; cap],
+            contrib: vec![S::ZERO; cap],
             medium: vec![0; cap],
             slot: vec![0; cap],
         }
     }
 
     #[inline]
-    fn push(&mut self, r: &ShadowRequest, slot: usize, time: f32) {
+    fn push(&mut self, r: &ShadowRequest<S>, slot: usize, time: f32) {
         let i = self.len;
         self.time[i] = time;
         self.o[i] = r.ray.o;
@@ -139,16 +145,16 @@ impl ShadowQueue {
 }
 
 /// One worker's reusable queues.
-pub struct Queues {
-    rays: RayQueue,
+pub struct Queues<T: Transport> {
+    rays: RayQueue<T>,
     hits: Vec<Option<Hit>>,
-    shadow: ShadowQueue,
+    shadow: ShadowQueue<T::S>,
 }
 
 /// Rays per queue: small enough that a queue's hot fields stay in L2.
 pub const QUEUE_CAPACITY: usize = 2048;
 
-impl Queues {
+impl<T: Transport> Queues<T> {
     pub fn new(cap: usize) -> Self {
         Self {
             rays: RayQueue::new(cap),
@@ -160,7 +166,7 @@ impl Queues {
     }
 }
 
-impl Default for Queues {
+impl<T: Transport> Default for Queues<T> {
     fn default() -> Self {
         Self::new(QUEUE_CAPACITY)
     }
@@ -168,9 +174,9 @@ impl Default for Queues {
 
 /// Renders samples `s0..s1` of every pixel of `tile`, adding each finished path's radiance to
 /// `film` (the tile's pixels, row-major).
-pub fn render_tile<const MOTION: bool, const MEDIA: bool>(
+pub fn render_tile<T: Transport, const MOTION: bool, const MEDIA: bool>(
     ctx: &Ctx,
-    q: &mut Queues,
+    q: &mut Queues<T>,
     tile: &Tile,
     s0: u32,
     s1: u32,
@@ -187,7 +193,7 @@ pub fn render_tile<const MOTION: bool, const MEDIA: bool>(
             while q.rays.len < cap && next < total {
                 let (p, k) = (next / spp, next % spp);
                 let (x, y) = tile.pixel(p);
-                let s = camera_ray::<MOTION>(ctx, x, y, s0 + k as u32);
+                let s = camera_ray::<T, MOTION>(ctx, x, y, s0 + k as u32);
                 let i = q.rays.len;
                 q.rays.store(i, &s);
                 q.rays.len += 1;
@@ -211,7 +217,7 @@ pub fn render_tile<const MOTION: bool, const MEDIA: bool>(
         for i in 0..n {
             let mut s = q.rays.load(i);
             let mut extra = None;
-            if let Some(r) = shade::<MOTION, MEDIA>(ctx, &mut s, q.hits[i], &mut extra) {
+            if let Some(r) = shade::<T, MOTION, MEDIA>(ctx, &mut s, q.hits[i], &mut extra) {
                 q.shadow.push(&r, i, s.time);
             }
             if let Some(r) = extra {
@@ -225,10 +231,16 @@ pub fn render_tile<const MOTION: bool, const MEDIA: bool>(
         for j in 0..sh.len {
             let ray = Ray::new(sh.o[j], sh.d[j]);
             if MEDIA {
-                let tr =
-                    ctx.scene
-                        .transmittance::<MOTION>(&ray, sh.t_max[j], sh.time[j], sh.medium[j]);
-                q.rays.l[sh.slot[j] as usize] += sh.contrib[j] * tr;
+                let slot = sh.slot[j] as usize;
+                let lambda = &q.rays.lambda[slot];
+                let tr = ctx.scene.transmittance_with::<MOTION, T::S>(
+                    &ray,
+                    sh.t_max[j],
+                    sh.time[j],
+                    sh.medium[j],
+                    |m, d| T::medium(ctx, m, lambda).transmittance(d),
+                );
+                q.rays.l[slot] += sh.contrib[j] * tr;
             } else if !ctx.scene.occluded::<MOTION>(&ray, sh.t_max[j], sh.time[j]) {
                 q.rays.l[sh.slot[j] as usize] += sh.contrib[j];
             }
@@ -238,7 +250,8 @@ pub fn render_tile<const MOTION: bool, const MEDIA: bool>(
         // paths at the end of the queue, so only as many records move as paths finished.
         for i in 0..n {
             if !q.rays.alive[i] {
-                super::accumulate(film, tile, ctx.width, q.rays.pixel[i], q.rays.l[i], stats);
+                let l = T::to_rgb(q.rays.l[i], &q.rays.lambda[i]);
+                super::accumulate(film, tile, ctx.width, q.rays.pixel[i], l, stats);
             }
         }
         let (mut lo, mut hi) = (0, n);

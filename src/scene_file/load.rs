@@ -33,6 +33,8 @@ pub struct LoadedScene {
     pub render: RenderSettings,
     /// Radiance of the constant environment (zero when absent).
     pub environment: Vec3,
+    /// What spectral transport evaluates for the environment.
+    pub environment_spectrum: crate::spectrum::EmitterSpectrum,
     /// Hash of the scene text and every override except the sample count, so renders of the
     /// same scene with different sample ranges can be matched.
     pub hash: u64,
@@ -265,9 +267,9 @@ fn build_world(scene: schema::Scene, path: &Path, hash: u64) -> Result<LoadedSce
             }
         }
     }
-    let environment = match &scene.environment {
-        Some(schema::Environment::Constant(e)) => e.0.vec(),
-        None => Vec3::ZERO,
+    let (environment, environment_spectrum) = match &scene.environment {
+        Some(schema::Environment::Constant(e)) => (e.rgb, e.spectrum),
+        None => (Vec3::ZERO, crate::spectrum::EmitterSpectrum::Rgb),
     };
 
     let mut world = hecs::World::new();
@@ -301,7 +303,8 @@ fn build_world(scene: schema::Scene, path: &Path, hash: u64) -> Result<LoadedSce
                 } => crate::components::light::PointLight {
                     position: transform.to_world.transform_point3(position.vec()),
                     direction: glam::Vec3::NEG_Y,
-                    intensity: intensity.0.vec(),
+                    intensity: intensity.rgb,
+                    spectrum: intensity.spectrum,
                     cos_cone: -1.0,
                     cos_falloff_start: -1.0,
                 },
@@ -317,7 +320,8 @@ fn build_world(scene: schema::Scene, path: &Path, hash: u64) -> Result<LoadedSce
                         .to_world
                         .transform_vector3(direction.vec())
                         .normalize(),
-                    intensity: intensity.0.vec(),
+                    intensity: intensity.rgb,
+                    spectrum: intensity.spectrum,
                     cos_cone: cone.to_radians().cos(),
                     cos_falloff_start: (cone - falloff).to_radians().cos(),
                 },
@@ -428,8 +432,9 @@ fn build_world(scene: schema::Scene, path: &Path, hash: u64) -> Result<LoadedSce
                     ));
                 }
                 Material::Light {
-                    emission: emission.0.vec(),
+                    emission: emission.rgb,
                     two_sided: *two_sided,
+                    spectrum: emission.spectrum,
                 }
             }
         };
@@ -490,6 +495,7 @@ fn build_world(scene: schema::Scene, path: &Path, hash: u64) -> Result<LoadedSce
         camera_path,
         render,
         environment,
+        environment_spectrum,
         hash,
     })
 }

@@ -139,6 +139,45 @@ impl Spectrum for Illuminant {
     }
 }
 
+/// What an emitter's spectrum is. Every emitter also has an RGB value (the
+/// linear sRGB colour of this spectrum), which RGB transport and light
+/// selection by power use; spectral transport evaluates this instead.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum EmitterSpectrum {
+    /// The emitter's RGB value, upsampled as an [`RgbIlluminant`](super::RgbIlluminant)
+    /// when transport is spectral.
+    Rgb,
+    Blackbody(Blackbody),
+    Illuminant(Illuminant),
+}
+
+impl EmitterSpectrum {
+    /// True for physically defined spectra, which turn spectral transport on.
+    pub fn is_spectral(&self) -> bool {
+        !matches!(self, Self::Rgb)
+    }
+
+    /// The linear sRGB colour of a spectral emitter (negative channels of
+    /// colours outside the sRGB gamut clipped to 0); `None` for `Rgb`.
+    pub fn rgb(&self) -> Option<glam::Vec3> {
+        let xyz = match self {
+            Self::Rgb => return None,
+            Self::Blackbody(b) => super::spectrum_to_xyz(|l| b.eval(l)),
+            Self::Illuminant(i) => super::spectrum_to_xyz(|l| i.eval(l)),
+        };
+        Some(super::xyz_to_linear_srgb(xyz).max(glam::Vec3::ZERO))
+    }
+
+    /// A short description for the effect manifest.
+    pub fn describe(&self) -> String {
+        match self {
+            Self::Rgb => "Rgb".into(),
+            Self::Blackbody(b) => format!("Blackbody {} K", b.kelvin()),
+            Self::Illuminant(i) => format!("Illuminant {:?}", i.which()),
+        }
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;

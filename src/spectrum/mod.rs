@@ -23,10 +23,10 @@ pub use cie::{
     CIE_Y_INTEGRAL, SRGB_TO_XYZ, XYZ_TO_SRGB, cie_xyz, d65, linear_srgb_to_xyz, luminance,
     reflectance_to_xyz, spectrum_to_xyz, to_xyz, xyz_to_chromaticity, xyz_to_linear_srgb,
 };
-pub use emitter::{Blackbody, Illuminant, NamedIlluminant, SUN_KELVIN, planck};
+pub use emitter::{Blackbody, EmitterSpectrum, Illuminant, NamedIlluminant, SUN_KELVIN, planck};
 pub use ior::{IorModel, IorPreset};
-pub use rgb2spec::{RgbIlluminant, RgbSigmoid};
-pub use sampled::{SampledSpectrum, Wavelengths, sample_visible_wavelength};
+pub use rgb2spec::{RgbIlluminant, RgbSigmoid, RgbUnbounded};
+pub use sampled::{Channels, SampledSpectrum, Wavelengths, sample_visible_wavelength};
 
 /// Shortest wavelength carried by a path, nm.
 pub const LAMBDA_MIN: f32 = 360.0;

@@ -261,6 +261,41 @@ impl Spectrum for RgbIlluminant {
     }
 }
 
+/// A non-negative, unbounded RGB quantity (a medium's σa or σs) as a
+/// smooth spectrum: `scale`·σ(…) with `scale` = 2·max(rgb), like
+/// [`RgbIlluminant`] without the illuminant (pbrt-v4's
+/// `RGBUnboundedSpectrum`).
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct RgbUnbounded {
+    scale: f32,
+    shape: RgbSigmoid,
+}
+
+impl RgbUnbounded {
+    /// Negative or NaN channels count as 0.
+    pub fn from_rgb(rgb: Vec3) -> Self {
+        let c = |v: f32| if v > 0.0 { v } else { 0.0 };
+        let rgb = Vec3::new(c(rgb.x), c(rgb.y), c(rgb.z));
+        let scale = 2.0 * rgb.max_element();
+        if !(scale > 0.0 && scale.is_finite()) {
+            return Self {
+                scale: 0.0,
+                shape: RgbSigmoid::grey(0.0),
+            };
+        }
+        Self {
+            scale,
+            shape: RgbSigmoid::from_rgb(rgb / scale),
+        }
+    }
+
+    /// Value at `lambda` nm.
+    #[inline]
+    pub fn eval(&self, lambda: f32) -> f32 {
+        self.scale * self.shape.eval(lambda)
+    }
+}
+
 // ---------------------------------------------------------------------------
 // The optimiser.
 

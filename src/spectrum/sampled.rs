@@ -26,7 +26,7 @@ const VIS_NORM: f32 = VIS_A / (VIS_T1 - VIS_T0);
 ///
 /// `pdf[i] == 0` marks a terminated wavelength (see
 /// [`Wavelengths::terminate_secondary`]); estimators must skip it.
-#[derive(Clone, Copy, Debug, PartialEq)]
+#[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct Wavelengths {
     /// Wavelengths, nm. `lambda[0]` is the hero.
     pub lambda: [f32; N_LAMBDA],
@@ -279,6 +279,57 @@ elementwise_op!(Add, add, AddAssign, add_assign, +);
 elementwise_op!(Sub, sub, SubAssign, sub_assign, -);
 elementwise_op!(Mul, mul, MulAssign, mul_assign, *);
 elementwise_op!(Div, div, DivAssign, div_assign, /);
+
+/// What light transport multiplies along a path: RGB triples ([`glam::Vec3`]) or spectral
+/// samples ([`SampledSpectrum`]). The integrator is generic over it, so RGB scenes run
+/// exactly the arithmetic they always did.
+pub trait Channels:
+    Copy
+    + std::fmt::Debug
+    + PartialEq
+    + Send
+    + Sync
+    + 'static
+    + Add<Output = Self>
+    + AddAssign
+    + Mul<Output = Self>
+    + MulAssign
+    + Mul<f32, Output = Self>
+    + MulAssign<f32>
+    + Div<f32, Output = Self>
+    + DivAssign<f32>
+{
+    const ZERO: Self;
+    const ONE: Self;
+    fn max_element(self) -> f32;
+    fn is_finite(self) -> bool;
+}
+
+impl Channels for glam::Vec3 {
+    const ZERO: Self = glam::Vec3::ZERO;
+    const ONE: Self = glam::Vec3::ONE;
+    #[inline]
+    fn max_element(self) -> f32 {
+        glam::Vec3::max_element(self)
+    }
+    #[inline]
+    fn is_finite(self) -> bool {
+        glam::Vec3::is_finite(self)
+    }
+}
+
+impl Channels for SampledSpectrum {
+    const ZERO: Self = SampledSpectrum::ZERO;
+    const ONE: Self = SampledSpectrum::ONE;
+    #[inline]
+    fn max_element(self) -> f32 {
+        self.max_value()
+    }
+    #[inline]
+    fn is_finite(self) -> bool {
+        self.0.iter().all(|v| v.is_finite())
+    }
+}
 
 #[cfg(test)]
 mod tests {

@@ -1,7 +1,8 @@
 //! `detect_effects`: which optional parts of light transport a scene needs.
 
 use crate::components::camera::CameraPath;
-use crate::components::{Camera, Motion, Name, Texture};
+use crate::components::{Camera, Material, Motion, Name, Texture};
+use crate::spectrum::{EmitterSpectrum, IorModel};
 use std::fmt;
 
 /// One optional effect of the renderer.
@@ -45,7 +46,7 @@ impl Effect {
 
     /// Whether this build can simulate the effect at all.
     pub fn implemented(self) -> bool {
-        !matches!(self, Effect::Spectral)
+        true
     }
 }
 
@@ -109,6 +110,7 @@ pub fn detect_effects(
     camera: &Camera,
     path: Option<&CameraPath>,
     shutter: (f32, f32),
+    environment: &EmitterSpectrum,
 ) -> Effects {
     let mut fx = Effects::default();
     if camera.aperture_radius > 0.0 {
@@ -168,13 +170,42 @@ pub fn detect_effects(
             format!("no Motion component on any of {entities} entities and a static camera"),
         );
     }
-    // The schema refuses dispersive IORs, spectral emitters, media and textures until they
-    // are simulated, so a loaded world never asks for them.
-    fx.set(
-        Effect::Spectral,
-        false,
-        "no dispersive IOR and no spectral emitter",
+    let mut spectral: Vec<String> = Vec::new();
+    let mut emitters: Vec<(hecs::Entity, String)> = world
+        .query::<(hecs::Entity, &Name, &Material)>()
+        .iter()
+        .filter_map(|(e, n, m)| match m {
+            Material::Dielectric { ior } if ior.is_dispersive() => {
+                Some((e, format!("entity \"{}\": {}", n.0, describe_ior(ior))))
+            }
+            Material::Light { spectrum, .. } if spectrum.is_spectral() => {
+                Some((e, format!("entity \"{}\": {}", n.0, spectrum.describe())))
+            }
+            _ => None,
+        })
+        .collect();
+    emitters.extend(
+        world
+            .query::<(hecs::Entity, &Name, &crate::components::PointLight)>()
+            .iter()
+            .filter(|(_, _, l)| l.spectrum.is_spectral())
+            .map(|(e, n, l)| (e, format!("entity \"{}\": {}", n.0, l.spectrum.describe()))),
     );
+    // Entities in file order, so the reason names the first one the user wrote.
+    emitters.sort_by_key(|(e, _)| e.id());
+    spectral.extend(emitters.into_iter().map(|(_, s)| s));
+    if environment.is_spectral() {
+        spectral.push(format!("environment: {}", environment.describe()));
+    }
+    if spectral.is_empty() {
+        fx.set(
+            Effect::Spectral,
+            false,
+            "no dispersive IOR and no spectral emitter",
+        );
+    } else {
+        fx.set(Effect::Spectral, true, list_reasons(&spectral));
+    }
     let named = |f: &dyn Fn(&Texture) -> bool| -> Vec<String> {
         world
             .query::<(&Name, &Texture)>()
@@ -225,4 +256,27 @@ pub fn detect_effects(
         );
     }
     fx
+}
+
+/// The first few reasons, and how many more.
+fn list_reasons(v: &[String]) -> String {
+    if v.len() > 3 {
+        format!("{} and {} more", v[..3].join("; "), v.len() - 3)
+    } else {
+        v.join("; ")
+    }
+}
+
+/// A dispersive IOR as the manifest shows it, e.g. `Cauchy b = 0.0137 µm²`.
+fn describe_ior(ior: &IorModel) -> String {
+    match ior {
+        IorModel::Constant(n) => format!("Constant {n}"),
+        IorModel::Cauchy { b, .. } => format!("Cauchy b = {b} µm²"),
+        IorModel::Sellmeier { .. } | IorModel::Sellmeier4 { .. } => {
+            format!(
+                "Sellmeier, n_d = {:.4}",
+                ior.eta(crate::integrator::transport::LAMBDA_D)
+            )
+        }
+    }
 }

@@ -29,6 +29,24 @@ pub struct LightSample {
     pub pdf: f32,
     /// A point or spot light: no other technique can find it, so MIS gives it full weight.
     pub delta: bool,
+    /// Which emitter, for spectral transport to evaluate its spectrum.
+    pub source: LightSource,
+}
+
+/// The emitter a light sample came from.
+#[derive(Clone, Copy, Debug)]
+pub enum LightSource {
+    /// An area light of material `material`, its colour modulated by the texture albedo `tex`.
+    Area {
+        material: u32,
+        tex: Option<Vec3>,
+    },
+    /// Point or spot light `light` (light index), its intensity scaled by falloff / d².
+    Point {
+        light: u32,
+        scale: f32,
+    },
+    Environment,
 }
 
 pub struct Lights {
@@ -68,19 +86,25 @@ impl Lights {
                     radiance: l,
                     pdf: pmf * crate::sampling::uniform_sphere_pdf(),
                     delta: false,
+                    source: LightSource::Environment,
                 })
             }
             LightKind::Point(pl) => {
                 let d = pl.position - p;
                 let d2 = d.length_squared();
                 let wi = d / d2.sqrt();
-                let radiance = pl.intensity_towards(-wi) / d2;
+                let scale = pl.falloff(-wi) / d2;
+                let radiance = pl.intensity * scale;
                 (radiance != Vec3::ZERO && radiance.is_finite()).then_some(LightSample {
                     wi,
                     point: Some((pl.position, Vec3::ZERO)),
                     radiance,
                     pdf: pmf,
                     delta: true,
+                    source: LightSource::Point {
+                        light: i as u32,
+                        scale,
+                    },
                 })
             }
             LightKind::Area(prim) => {
@@ -99,11 +123,14 @@ impl Lights {
                 }
                 let d = s.p - p;
                 let wi = d.normalize_or_zero();
-                let mut m = prims.materials[prims.material[prim as usize] as usize];
+                let material = prims.material[prim as usize];
+                let mut m = prims.materials[material as usize];
+                let mut tex = None;
                 if textures && let Some(t) = prims.texture_of(prim) {
                     let q = motion.map_or(s.p, |mo| mo.point_to_rest(s.p, time));
                     if let Some(a) = t.albedo(prims.uv_at(prim, q)) {
                         m = m.modulated(a);
+                        tex = Some(a);
                     }
                 }
                 let radiance = emitted(&m, s.n, -wi);
@@ -113,6 +140,7 @@ impl Lights {
                     radiance,
                     pdf: pmf * s.pdf,
                     delta: false,
+                    source: LightSource::Area { material, tex },
                 })
             }
         }
@@ -151,13 +179,13 @@ impl Lights {
     /// Chooses a light exactly as `sample` does; returns it when it is a point or spot light
     /// (the lights equiangular sampling aims at), with its selection probability.
     #[inline]
-    pub fn pick_point(&self, u_select: f32) -> Option<(crate::components::PointLight, f32)> {
+    pub fn pick_point(&self, u_select: f32) -> Option<(u32, crate::components::PointLight, f32)> {
         if self.lights.is_empty() {
             return None;
         }
         let (i, pmf) = self.table.sample(u_select);
         match self.lights[i] {
-            LightKind::Point(p) => Some((p, pmf)),
+            LightKind::Point(p) => Some((i as u32, p, pmf)),
             _ => None,
         }
     }
@@ -210,6 +238,7 @@ pub fn gather_lights(
             crate::components::Material::Light {
                 emission,
                 two_sided,
+                ..
             } => (emission, if two_sided { 2.0 } else { 1.0 }),
             _ => unreachable!("is_emissive"),
         };

@@ -34,6 +34,7 @@ pub struct RenderScene {
     /// Shutter interval of this frame in scene time (frames): [frame + open, frame + close].
     pub shutter: (f32, f32),
     pub environment: Vec3,
+    pub environment_spectrum: crate::spectrum::EmitterSpectrum,
     pub effects: Effects,
     pub settings: RenderSettings,
     pub accel_seconds: f64,
@@ -63,6 +64,7 @@ pub fn prepare_frame(scene: &LoadedScene, params: &KdParams, frame: u32) -> Rend
         &scene.camera,
         scene.camera_path.as_ref(),
         shutter,
+        &scene.environment_spectrum,
     );
     let mut prims = gather_primitives(&scene.world);
     prims.sweep = shutter;
@@ -92,6 +94,7 @@ pub fn prepare_frame(scene: &LoadedScene, params: &KdParams, frame: u32) -> Rend
         accel,
         lights,
         environment: scene.environment,
+        environment_spectrum: scene.environment_spectrum,
         effects,
         settings: s.clone(),
         accel_seconds,
@@ -111,6 +114,7 @@ impl RenderScene {
             &scene.camera,
             scene.camera_path.as_ref(),
             shutter,
+            &scene.environment_spectrum,
         );
         let cam = match &scene.camera_path {
             Some(p) => p.at(shutter.0, &scene.camera),
@@ -150,20 +154,36 @@ impl RenderScene {
         ray: &Ray,
         t_max: f32,
         time: f32,
-        mut medium: u32,
+        medium: u32,
     ) -> Vec3 {
+        self.transmittance_with::<MOTION, Vec3>(ray, t_max, time, medium, |m, d| {
+            self.prims.media[m as usize].transmittance(d)
+        })
+    }
+
+    /// [`Self::transmittance`] in any channels: `medium_tr(m, d)` is medium `m`'s
+    /// transmittance over distance `d`.
+    #[inline]
+    pub fn transmittance_with<const MOTION: bool, S: crate::spectrum::Channels>(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        time: f32,
+        mut medium: u32,
+        medium_tr: impl Fn(u32, f32) -> S,
+    ) -> S {
         let len = ray.d.length();
         let mut r = *ray;
         let mut t_left = t_max;
-        let mut tr = Vec3::ONE;
+        let mut tr = S::ONE;
         // A ray crosses each boundary once per pass through it; nesting deeper than this
         // would be a loop from rounding, and the light is treated as blocked.
         for _ in 0..64 {
             let seg = |m: u32, t: f32| {
                 if m == primitives::NO_MEDIUM {
-                    Vec3::ONE
+                    S::ONE
                 } else {
-                    self.prims.media[m as usize].transmittance(t * len)
+                    medium_tr(m, t * len)
                 }
             };
             let Some(hit) = self.intersect::<MOTION>(&r, t_left, time) else {
@@ -171,10 +191,10 @@ impl RenderScene {
             };
             let m = self.prims.materials[self.prims.material[hit.prim as usize] as usize];
             if !matches!(m, crate::components::Material::Boundary) {
-                return Vec3::ZERO;
+                return S::ZERO;
             }
             tr *= seg(medium, hit.t);
-            if tr == Vec3::ZERO {
+            if tr == S::ZERO {
                 return tr;
             }
             let sp = self.prims.surface_at::<MOTION>(&r, &hit, time);
@@ -188,7 +208,7 @@ impl RenderScene {
                 return tr;
             }
         }
-        Vec3::ZERO
+        S::ZERO
     }
 
     /// Whether anything blocks `ray` before `t_max`, at `time` when MOTION is on.

@@ -649,6 +649,7 @@ pub fn emitted(material: &Material, n: Vec3, wo: Vec3) -> Vec3 {
         Material::Light {
             emission,
             two_sided,
+            ..
         } if two_sided || n.dot(wo) > 0.0 => emission,
         _ => Vec3::ZERO,
     }

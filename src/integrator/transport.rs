@@ -1,0 +1,414 @@
+//! RGB or spectral transport: what a path carries and how scene colours enter it.
+//!
+//! The integrator is generic over [`Transport`]. [`Rgb`] multiplies linear sRGB triples, as
+//! the renderer does for every scene without a spectral cause. [`Spectral`] carries four
+//! wavelengths per path (hero wavelength sampling, Wilkie et al. 2014): reflectances and
+//! emitters are evaluated at those wavelengths (RGB inputs upsampled by Jakob & Hanika 2019),
+//! a dispersive interface keeps only the hero, and the film receives the CIE XYZ estimate
+//! converted to linear sRGB (the conversion is linear, so converting each sample equals
+//! converting the accumulated XYZ).
+
+use super::path::Ctx;
+use crate::medium::{DistanceSample, HomogeneousMedium};
+use crate::spectrum::{
+    Channels, EmitterSpectrum, IorModel, RgbIlluminant, RgbSigmoid, RgbUnbounded, SampledSpectrum,
+    Wavelengths,
+};
+use crate::systems::lights::{LightSample, LightSource};
+use crate::systems::{LightKind, RenderScene};
+use glam::{Vec2, Vec3};
+
+/// Wavelength at which RGB transport evaluates a dispersive IOR: the helium d line, where
+/// glass catalogues quote n_d.
+pub const LAMBDA_D: f32 = 587.56;
+
+/// A homogeneous medium with coefficients in the transport's channels.
+pub trait MediumOps<S>: Copy {
+    fn sigma_s(&self) -> S;
+    fn transmittance(&self, d: f32) -> S;
+    fn sample_distance(&self, t_max: f32, u_c: f32, u: f32, probs: S) -> DistanceSample<S>;
+    fn distance_pdf(&self, t: f32, probs: S) -> f32;
+    fn phase(&self, wo: Vec3, wi: Vec3) -> f32;
+    fn sample_phase(&self, wo: Vec3, u: Vec2) -> (Vec3, f32);
+}
+
+impl MediumOps<Vec3> for HomogeneousMedium {
+    #[inline]
+    fn sigma_s(&self) -> Vec3 {
+        self.sigma_s
+    }
+    #[inline]
+    fn transmittance(&self, d: f32) -> Vec3 {
+        HomogeneousMedium::transmittance(self, d)
+    }
+    #[inline]
+    fn sample_distance(&self, t_max: f32, u_c: f32, u: f32, probs: Vec3) -> DistanceSample {
+        HomogeneousMedium::sample_distance(self, t_max, u_c, u, probs)
+    }
+    #[inline]
+    fn distance_pdf(&self, t: f32, probs: Vec3) -> f32 {
+        HomogeneousMedium::distance_pdf(self, t, probs)
+    }
+    #[inline]
+    fn phase(&self, wo: Vec3, wi: Vec3) -> f32 {
+        HomogeneousMedium::phase(self, wo, wi)
+    }
+    #[inline]
+    fn sample_phase(&self, wo: Vec3, u: Vec2) -> (Vec3, f32) {
+        HomogeneousMedium::sample_phase(self, wo, u)
+    }
+}
+
+/// A medium evaluated at one path's four wavelengths.
+#[derive(Clone, Copy, Debug)]
+pub struct SpectralMedium {
+    sigma_s: SampledSpectrum,
+    sigma_t: SampledSpectrum,
+    g: f32,
+}
+
+impl MediumOps<SampledSpectrum> for SpectralMedium {
+    #[inline]
+    fn sigma_s(&self) -> SampledSpectrum {
+        self.sigma_s
+    }
+    #[inline]
+    fn transmittance(&self, d: f32) -> SampledSpectrum {
+        SampledSpectrum(crate::medium::transmittance_channels(self.sigma_t.0, d))
+    }
+    #[inline]
+    fn sample_distance(
+        &self,
+        t_max: f32,
+        u_c: f32,
+        u: f32,
+        probs: SampledSpectrum,
+    ) -> DistanceSample<SampledSpectrum> {
+        crate::medium::sample_free_flight(self.sigma_s.0, self.sigma_t.0, t_max, u_c, u, probs.0)
+            .map(SampledSpectrum)
+    }
+    #[inline]
+    fn distance_pdf(&self, t: f32, probs: SampledSpectrum) -> f32 {
+        crate::medium::free_flight_pdf(self.sigma_t.0, t, probs.0)
+    }
+    #[inline]
+    fn phase(&self, wo: Vec3, wi: Vec3) -> f32 {
+        crate::medium::hg_phase_dirs(wo, wi, self.g)
+    }
+    #[inline]
+    fn sample_phase(&self, wo: Vec3, u: Vec2) -> (Vec3, f32) {
+        crate::medium::sample_hg(wo, self.g, u)
+    }
+}
+
+/// How one emitter's spectrum is evaluated in spectral transport.
+#[derive(Clone, Copy, Debug)]
+pub enum EmitSpec {
+    Zero,
+    Rgb(RgbIlluminant),
+    Physical(EmitterSpectrum),
+}
+
+impl EmitSpec {
+    fn new(rgb: Vec3, spectrum: EmitterSpectrum) -> Self {
+        match spectrum {
+            EmitterSpectrum::Rgb if rgb.max_element() > 0.0 => {
+                EmitSpec::Rgb(RgbIlluminant::from_rgb(rgb))
+            }
+            EmitterSpectrum::Rgb => EmitSpec::Zero,
+            s => EmitSpec::Physical(s),
+        }
+    }
+
+    #[inline]
+    fn eval(&self, lam: &Wavelengths) -> SampledSpectrum {
+        match self {
+            EmitSpec::Zero => SampledSpectrum::ZERO,
+            EmitSpec::Rgb(s) => SampledSpectrum(lam.lambda.map(|l| s.eval(l))),
+            EmitSpec::Physical(EmitterSpectrum::Blackbody(b)) => {
+                SampledSpectrum(lam.lambda.map(|l| b.eval(l)))
+            }
+            EmitSpec::Physical(EmitterSpectrum::Illuminant(i)) => {
+                SampledSpectrum(lam.lambda.map(|l| i.eval(l)))
+            }
+            EmitSpec::Physical(EmitterSpectrum::Rgb) => SampledSpectrum::ZERO,
+        }
+    }
+}
+
+/// Per-render spectral forms of the scene's colours, computed once (a table lookup per
+/// material) so the per-hit cost is evaluating a sigmoid at four wavelengths.
+#[derive(Debug, Default)]
+pub struct SpectralData {
+    /// Per material: the albedo (Diffuse) or tint (Mirror) as a smooth reflectance.
+    refl: Vec<RgbSigmoid>,
+    /// Per material: emission.
+    emit: Vec<EmitSpec>,
+    /// Per light index: point and spot light intensity (`Zero` for other lights).
+    point: Vec<EmitSpec>,
+    environment: Option<EmitSpec>,
+    /// Per medium: σa, σs as smooth unbounded spectra, and g.
+    media: Vec<(RgbUnbounded, RgbUnbounded, f32)>,
+}
+
+impl SpectralData {
+    pub const EMPTY: SpectralData = SpectralData {
+        refl: Vec::new(),
+        emit: Vec::new(),
+        point: Vec::new(),
+        environment: None,
+        media: Vec::new(),
+    };
+
+    pub fn new(scene: &RenderScene) -> Self {
+        use crate::components::Material;
+        let prims = &scene.prims;
+        let refl = prims
+            .materials
+            .iter()
+            .map(|m| match *m {
+                Material::Diffuse { albedo } => RgbSigmoid::from_rgb(albedo),
+                Material::Mirror { tint } => RgbSigmoid::from_rgb(tint),
+                _ => RgbSigmoid::grey(0.0),
+            })
+            .collect();
+        let emit = prims
+            .materials
+            .iter()
+            .map(|m| match *m {
+                Material::Light {
+                    emission, spectrum, ..
+                } => EmitSpec::new(emission, spectrum),
+                _ => EmitSpec::Zero,
+            })
+            .collect();
+        let point = scene
+            .lights
+            .lights
+            .iter()
+            .map(|l| match l {
+                LightKind::Point(p) => EmitSpec::new(p.intensity, p.spectrum),
+                _ => EmitSpec::Zero,
+            })
+            .collect();
+        let media = prims
+            .media
+            .iter()
+            .map(|m| {
+                (
+                    RgbUnbounded::from_rgb(m.sigma_a),
+                    RgbUnbounded::from_rgb(m.sigma_s),
+                    m.g,
+                )
+            })
+            .collect();
+        SpectralData {
+            refl,
+            emit,
+            point,
+            environment: Some(EmitSpec::new(scene.environment, scene.environment_spectrum)),
+            media,
+        }
+    }
+}
+
+/// What a path carries, and how the scene's colours become that.
+pub trait Transport: Copy + Send + Sync + 'static {
+    type S: Channels;
+    /// The path's wavelengths (nothing in RGB).
+    type Lambda: Copy + std::fmt::Debug + Default + Send + Sync;
+    type Med: MediumOps<Self::S>;
+
+    fn wavelengths(ctx: &Ctx, pixel: u32, index: u32) -> Self::Lambda;
+    /// Throughput of a new path: one on every live wavelength.
+    fn initial_beta(lam: &Self::Lambda) -> Self::S;
+    /// Material `mat`'s reflectance, `rgb` its (possibly texture-modulated) colour.
+    fn reflectance(ctx: &Ctx, mat: u32, rgb: Vec3, textured: bool, lam: &Self::Lambda) -> Self::S;
+    /// Radiance `le` (RGB, already texture-modulated by `tex`) of emitter material `mat`.
+    fn emission(ctx: &Ctx, mat: u32, le: Vec3, tex: Option<Vec3>, lam: &Self::Lambda) -> Self::S;
+    fn light_radiance(ctx: &Ctx, ls: &LightSample, lam: &Self::Lambda) -> Self::S;
+    /// A point light's intensity times `scale` (falloff / d²).
+    fn point_radiance(ctx: &Ctx, light: u32, rgb: Vec3, scale: f32, lam: &Self::Lambda) -> Self::S;
+    fn environment(ctx: &Ctx, lam: &Self::Lambda) -> Self::S;
+    /// The relative IOR to use at this interface; a dispersive one ends the secondary
+    /// wavelengths (and their throughput).
+    fn eta(ior: &IorModel, lam: &mut Self::Lambda, beta: &mut Self::S) -> f32;
+    fn medium(ctx: &Ctx, m: u32, lam: &Self::Lambda) -> Self::Med;
+    /// The path's radiance as linear sRGB for the film.
+    fn to_rgb(l: Self::S, lam: &Self::Lambda) -> Vec3;
+}
+
+/// Three-channel linear sRGB transport.
+#[derive(Clone, Copy, Debug)]
+pub struct Rgb;
+
+impl Transport for Rgb {
+    type S = Vec3;
+    type Lambda = ();
+    type Med = HomogeneousMedium;
+
+    #[inline]
+    fn wavelengths(_: &Ctx, _: u32, _: u32) {}
+    #[inline]
+    fn initial_beta(_: &()) -> Vec3 {
+        Vec3::ONE
+    }
+    #[inline]
+    fn reflectance(_: &Ctx, _: u32, rgb: Vec3, _: bool, _: &()) -> Vec3 {
+        rgb
+    }
+    #[inline]
+    fn emission(_: &Ctx, _: u32, le: Vec3, _: Option<Vec3>, _: &()) -> Vec3 {
+        le
+    }
+    #[inline]
+    fn light_radiance(_: &Ctx, ls: &LightSample, _: &()) -> Vec3 {
+        ls.radiance
+    }
+    #[inline]
+    fn point_radiance(_: &Ctx, _: u32, rgb: Vec3, scale: f32, _: &()) -> Vec3 {
+        rgb * scale
+    }
+    #[inline]
+    fn environment(ctx: &Ctx, _: &()) -> Vec3 {
+        ctx.scene.environment
+    }
+    #[inline]
+    fn eta(ior: &IorModel, _: &mut (), _: &mut Vec3) -> f32 {
+        match *ior {
+            IorModel::Constant(n) => n,
+            ref m => m.eta(LAMBDA_D),
+        }
+    }
+    #[inline]
+    fn medium(ctx: &Ctx, m: u32, _: &()) -> HomogeneousMedium {
+        ctx.scene.prims.media[m as usize]
+    }
+    #[inline]
+    fn to_rgb(l: Vec3, _: &()) -> Vec3 {
+        l
+    }
+}
+
+/// Four wavelengths per path, film in CIE XYZ converted to linear sRGB.
+#[derive(Clone, Copy, Debug)]
+pub struct Spectral;
+
+#[inline]
+fn sigmoid4(s: &RgbSigmoid, lam: &Wavelengths) -> SampledSpectrum {
+    SampledSpectrum(lam.lambda.map(|l| s.eval(l)))
+}
+
+impl Transport for Spectral {
+    type S = SampledSpectrum;
+    type Lambda = Wavelengths;
+    type Med = SpectralMedium;
+
+    #[inline]
+    fn wavelengths(ctx: &Ctx, pixel: u32, index: u32) -> Wavelengths {
+        let u = ctx
+            .sampler
+            .get_1d(pixel, index, super::path::DIM_WAVELENGTH);
+        let mut lam = Wavelengths::sample_visible(u);
+        if ctx.single_wavelength {
+            lam.terminate_secondary();
+        }
+        lam
+    }
+    #[inline]
+    fn initial_beta(lam: &Wavelengths) -> SampledSpectrum {
+        SampledSpectrum(lam.pdf.map(|p| if p > 0.0 { 1.0 } else { 0.0 }))
+    }
+    #[inline]
+    fn reflectance(
+        ctx: &Ctx,
+        mat: u32,
+        rgb: Vec3,
+        textured: bool,
+        lam: &Wavelengths,
+    ) -> SampledSpectrum {
+        if textured {
+            sigmoid4(&RgbSigmoid::from_rgb(rgb), lam)
+        } else {
+            sigmoid4(&ctx.spectral.refl[mat as usize], lam)
+        }
+    }
+    #[inline]
+    fn emission(
+        ctx: &Ctx,
+        mat: u32,
+        le: Vec3,
+        tex: Option<Vec3>,
+        lam: &Wavelengths,
+    ) -> SampledSpectrum {
+        let spec = &ctx.spectral.emit[mat as usize];
+        match (tex, spec) {
+            (None, s) => s.eval(lam),
+            // A textured RGB emitter: the modulated colour is the emitter's colour.
+            (Some(_), EmitSpec::Rgb(_)) => {
+                let s = RgbIlluminant::from_rgb(le);
+                SampledSpectrum(lam.lambda.map(|l| s.eval(l)))
+            }
+            (Some(t), s) => s.eval(lam) * sigmoid4(&RgbSigmoid::from_rgb(t), lam),
+        }
+    }
+    #[inline]
+    fn light_radiance(ctx: &Ctx, ls: &LightSample, lam: &Wavelengths) -> SampledSpectrum {
+        match ls.source {
+            LightSource::Area { material, tex } => {
+                Self::emission(ctx, material, ls.radiance, tex, lam)
+            }
+            LightSource::Point { light, scale } => {
+                Self::point_radiance(ctx, light, ls.radiance, scale, lam)
+            }
+            LightSource::Environment => Self::environment(ctx, lam),
+        }
+    }
+    #[inline]
+    fn point_radiance(
+        ctx: &Ctx,
+        light: u32,
+        _: Vec3,
+        scale: f32,
+        lam: &Wavelengths,
+    ) -> SampledSpectrum {
+        ctx.spectral.point[light as usize].eval(lam) * scale
+    }
+    #[inline]
+    fn environment(ctx: &Ctx, lam: &Wavelengths) -> SampledSpectrum {
+        ctx.spectral
+            .environment
+            .map_or(SampledSpectrum::ZERO, |e| e.eval(lam))
+    }
+    #[inline]
+    fn eta(ior: &IorModel, lam: &mut Wavelengths, beta: &mut SampledSpectrum) -> f32 {
+        match *ior {
+            IorModel::Constant(n) => n,
+            ref m => {
+                // Each wavelength would refract its own way: only the hero goes on.
+                if !lam.secondary_terminated() {
+                    lam.terminate_secondary();
+                    for b in &mut beta.0[1..] {
+                        *b = 0.0;
+                    }
+                }
+                m.eta(lam.lambda[0])
+            }
+        }
+    }
+    #[inline]
+    fn medium(ctx: &Ctx, m: u32, lam: &Wavelengths) -> SpectralMedium {
+        let (a, s, g) = &ctx.spectral.media[m as usize];
+        let sigma_a = SampledSpectrum(lam.lambda.map(|l| a.eval(l)));
+        let sigma_s = SampledSpectrum(lam.lambda.map(|l| s.eval(l)));
+        SpectralMedium {
+            sigma_s,
+            sigma_t: sigma_a + sigma_s,
+            g: *g,
+        }
+    }
+    #[inline]
+    fn to_rgb(l: SampledSpectrum, lam: &Wavelengths) -> Vec3 {
+        crate::spectrum::xyz_to_linear_srgb(crate::spectrum::to_xyz(&l, lam))
+    }
+}
