@@ -112,8 +112,8 @@ Scene(
         );
         let img = render(&text, true);
         let m = means(&img);
-        for c in 0..3 {
-            assert!((m[c] - 1.0).abs() < 0.01, "{sky}: channel {c} = {}", m[c]);
+        for (c, v) in m.iter().enumerate() {
+            assert!((v - 1.0).abs() < 0.01, "{sky}: channel {c} = {v}");
         }
         // A background pixel sees the sky itself.
         let corner = img.pixels[0];
