@@ -175,11 +175,12 @@ fn effects(c: &mut Criterion) {
     let mut g = c.benchmark_group("effects");
     g.sample_size(10);
     let opts = wavefront(2);
-    let sets: [(&str, &[Effect]); 4] = [
+    let sets: [(&str, &[Effect]); 5] = [
         ("none", &[]),
         ("lens", &[Effect::Lens]),
         ("motion", &[Effect::Motion]),
         ("lens_motion", &[Effect::Lens, Effect::Motion]),
+        ("spectral", &[Effect::Spectral]),
     ];
     for (name, set) in sets {
         let mut scene = cornell(48, 2);
@@ -187,6 +188,27 @@ fn effects(c: &mut Criterion) {
             scene.effects.force(*e).unwrap();
         }
         g.bench_function(format!("cornell_48x48_2spp_{name}"), |b| {
+            b.iter(|| render(&scene, &opts, &|_| {}).stats.samples)
+        });
+    }
+    g.finish();
+}
+
+/// Spectral transport (4 hero wavelengths) against RGB on the non-dispersive Cornell box with
+/// SPECTRAL forced on: the price of carrying wavelengths where no effect needs them.
+fn spectral(c: &mut Criterion) {
+    use prism::systems::Effect;
+    let mut g = c.benchmark_group("spectral");
+    g.sample_size(10);
+    let opts = wavefront(4);
+    for (name, force) in [("rgb", false), ("spectral_4", true)] {
+        let mut scene = cornell(64, 4);
+        if force {
+            scene.effects.force(Effect::Spectral).unwrap();
+            // The upsampling table is built on first use; keep it out of the timing.
+            prism::spectrum::rgb2spec::init_table();
+        }
+        g.bench_function(format!("cornell_64x64_4spp_{name}"), |b| {
             b.iter(|| render(&scene, &opts, &|_| {}).stats.samples)
         });
     }
@@ -269,6 +291,6 @@ fn media(c: &mut Criterion) {
 }
 
 criterion_group!(
-    benches, kdtree, camera, integrator, effects, textures, media
+    benches, kdtree, camera, integrator, effects, spectral, textures, media
 );
 criterion_main!(benches);
