@@ -124,7 +124,7 @@ impl EmitSpec {
     fn eval(&self, lam: &Wavelengths) -> SampledSpectrum {
         match self {
             EmitSpec::Zero => SampledSpectrum::ZERO,
-            EmitSpec::Rgb(s) => SampledSpectrum(lam.lambda.map(|l| s.eval(l))),
+            EmitSpec::Rgb(s) => SampledSpectrum(s.eval4(lam.lambda)),
             EmitSpec::Physical(EmitterSpectrum::Blackbody(b)) => {
                 SampledSpectrum(lam.lambda.map(|l| b.eval(l)))
             }
@@ -296,7 +296,7 @@ pub struct Spectral;
 
 #[inline]
 fn sigmoid4(s: &RgbSigmoid, lam: &Wavelengths) -> SampledSpectrum {
-    SampledSpectrum(lam.lambda.map(|l| s.eval(l)))
+    SampledSpectrum(s.eval4(lam.lambda))
 }
 
 impl Transport for Spectral {
@@ -346,8 +346,7 @@ impl Transport for Spectral {
             (None, s) => s.eval(lam),
             // A textured RGB emitter: the modulated colour is the emitter's colour.
             (Some(_), EmitSpec::Rgb(_)) => {
-                let s = RgbIlluminant::from_rgb(le);
-                SampledSpectrum(lam.lambda.map(|l| s.eval(l)))
+                SampledSpectrum(RgbIlluminant::from_rgb(le).eval4(lam.lambda))
             }
             (Some(t), s) => s.eval(lam) * sigmoid4(&RgbSigmoid::from_rgb(t), lam),
         }
@@ -399,8 +398,8 @@ impl Transport for Spectral {
     #[inline]
     fn medium(ctx: &Ctx, m: u32, lam: &Wavelengths) -> SpectralMedium {
         let (a, s, g) = &ctx.spectral.media[m as usize];
-        let sigma_a = SampledSpectrum(lam.lambda.map(|l| a.eval(l)));
-        let sigma_s = SampledSpectrum(lam.lambda.map(|l| s.eval(l)));
+        let sigma_a = SampledSpectrum(a.eval4(lam.lambda));
+        let sigma_s = SampledSpectrum(s.eval4(lam.lambda));
         SpectralMedium {
             sigma_s,
             sigma_t: sigma_a + sigma_s,

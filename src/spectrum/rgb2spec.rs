@@ -132,6 +132,22 @@ impl RgbSigmoid {
         self.scale * sigmoid((self.c[0] * t + self.c[1]) * t + self.c[2])
     }
 
+    /// Reflectance at four wavelengths at once (the path's), as [`RgbSigmoid::eval`] in
+    /// 4-wide arithmetic: one polynomial, one square root and one division per call.
+    #[inline]
+    pub fn eval4(&self, lambda: [f32; 4]) -> [f32; 4] {
+        use glam::Vec4;
+        let t = (Vec4::from_array(lambda) - Vec4::splat(T_CENTRE)) / T_HALF;
+        let x = (Vec4::splat(self.c[0]) * t + Vec4::splat(self.c[1])) * t + Vec4::splat(self.c[2]);
+        // The same cancellation-free form as `sigmoid`: the tail 1/(2r(r + |x|)) on the
+        // dark side, one minus it on the bright side.
+        let a = x.abs();
+        let r = (Vec4::ONE + a * a).sqrt();
+        let tail = Vec4::ONE / (2.0 * r * (r + a));
+        let s = Vec4::select(x.cmplt(Vec4::ZERO), tail, Vec4::ONE - tail);
+        (s * self.scale).to_array()
+    }
+
     /// Largest reflectance over [`LAMBDA_MIN`]..=[`LAMBDA_MAX`] (σ is
     /// monotonic, so the polynomial's maximum decides: an end or the vertex).
     pub fn max_value(&self) -> f32 {
@@ -253,6 +269,14 @@ impl RgbIlluminant {
     pub fn eval(&self, lambda: f32) -> f32 {
         self.scale * self.shape.eval(lambda) * d65(lambda) / D65_LUMINANCE
     }
+
+    /// [`RgbIlluminant::eval`] at four wavelengths.
+    #[inline]
+    pub fn eval4(&self, lambda: [f32; 4]) -> [f32; 4] {
+        let s = self.shape.eval4(lambda);
+        let k = self.scale / D65_LUMINANCE;
+        std::array::from_fn(|i| k * s[i] * d65(lambda[i]))
+    }
 }
 
 impl Spectrum for RgbIlluminant {
@@ -293,6 +317,12 @@ impl RgbUnbounded {
     #[inline]
     pub fn eval(&self, lambda: f32) -> f32 {
         self.scale * self.shape.eval(lambda)
+    }
+
+    /// [`RgbUnbounded::eval`] at four wavelengths.
+    #[inline]
+    pub fn eval4(&self, lambda: [f32; 4]) -> [f32; 4] {
+        self.shape.eval4(lambda).map(|v| v * self.scale)
     }
 }
 

@@ -55,8 +55,11 @@ impl Wavelengths {
             if ui >= 1.0 {
                 ui -= 1.0;
             }
-            lambda[i] = sample_visible_wavelength(ui);
-            pdf[i] = Self::visible_pdf(lambda[i]);
+            // With t the CDF's tanh value, cosh²(A(λ − μ)) = 1/(1 − t²): the pdf needs no
+            // transcendental beyond the inverse CDF's one.
+            let t = VIS_T0 + ui * (VIS_T1 - VIS_T0);
+            lambda[i] = (VIS_MU + t.atanh() / VIS_A).clamp(LAMBDA_MIN, LAMBDA_MAX);
+            pdf[i] = VIS_NORM * (1.0 - t * t);
         }
         Self { lambda, pdf }
     }
