@@ -69,14 +69,17 @@ fn refract2(d: (f64, f64), n: (f64, f64), eta: f64) -> Option<(f64, f64)> {
     })
 }
 
+/// A point or direction in the xz plane.
+type P2 = (f64, f64);
+
 /// A ray in the xz plane through the prism by Snell's law at both faces (entering, then
 /// leaving): the exit point and direction, or `None` if it misses a face or is totally
 /// internally reflected.
-fn through_prism(n: f64, mut o: (f64, f64), mut d: (f64, f64)) -> Option<((f64, f64), (f64, f64))> {
+fn through_prism(n: f64, mut o: P2, mut d: P2) -> Option<(P2, P2)> {
     let p = prism_triangle();
     let mut inside = false;
     for _ in 0..2 {
-        let mut best: Option<(f64, (f64, f64), (f64, f64))> = None;
+        let mut best: Option<(f64, P2, P2)> = None;
         for i in 0..3 {
             let (a, b) = (p[i], p[(i + 1) % 3]);
             let e = (b.0 - a.0, b.1 - a.1);
