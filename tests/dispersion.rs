@@ -184,7 +184,7 @@ fn prism_spreads_the_spectrum_in_order_at_the_predicted_places() {
         &text[cam_end..]
     )
     .replace(
-        "render: (width: 480, height: 300, spp: 1024,",
+        "render: (width: 480, height: 300, spp: 4096,",
         "render: (width: 320, height: 32, spp: 16,",
     );
     let loaded =
