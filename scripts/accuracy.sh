@@ -13,6 +13,11 @@ $p converge scenes/cornell.ron --size 128x128 --reference-spp 4096 --budget "$bu
     --vary light_sampling=Nee,Path --vary max_depth=3,12 -o "$out/cornell" --quiet > /dev/null
 $p converge scenes/caustics.ron --size 128x128 --reference-spp 4096 --budget "$budget" \
     --vary fresnel=Exact,Schlick -o "$out/caustics" --quiet > /dev/null
+# Dispersive scenes: hero wavelength sampling (4 wavelengths per path) against one.
+$p converge scenes/diamond_bunny.ron --size 96x72 --reference-spp 8192 --budget "$budget" \
+    --vary wavelengths=1,4 -o "$out/diamond_bunny" --quiet > /dev/null
+$p converge scenes/prism.ron --size 96x60 --reference-spp 16384 --budget "$budget" \
+    --vary wavelengths=1,4 -o "$out/prism" --quiet > /dev/null
 $p costs scenes/cornell.ron scenes/caustics.ron scenes/motion_blur.ron scenes/earth_dof.ron \
     --size 128x128 --spp 8 --runs 5 > "$out/effect_costs.md"
 

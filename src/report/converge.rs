@@ -76,7 +76,12 @@ fn apply_knob(c: &mut Config, key: &str, value: &str) -> Result<(), String> {
                 .map_err(|_| format!("--vary spp: '{value}' is not a sample count"))?;
             c.spp = Some(vec![n]);
         }
-        "force" | "spectral" | "effect" => {
+        "spectral" => match value {
+            "auto" | "none" | "off" => {}
+            "forced" | "force" | "on" => c.force.push(Effect::Spectral),
+            _ => return Err(format!("--vary spectral: '{value}' is not auto or forced")),
+        },
+        "force" | "effect" => {
             if !matches!(value, "none" | "auto") {
                 let e = Effect::parse(value)
                     .ok_or_else(|| format!("--vary {key}: unknown effect '{value}'"))?;
