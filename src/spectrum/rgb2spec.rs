@@ -241,41 +241,25 @@ const D65_LUMINANCE: f32 = (D65_Y_SUM / CIE_Y_INTEGRAL as f64) as f32;
 /// mean "this RGB seen on an sRGB display", so (1, 1, 1) renders as
 /// (1, 1, 1).
 #[derive(Clone, Copy, Debug, PartialEq)]
-pub struct RgbIlluminant {
-    scale: f32,
-    shape: RgbSigmoid,
-}
+pub struct RgbIlluminant(RgbUnbounded);
 
 impl RgbIlluminant {
     /// Emission for a linear sRGB colour; negative or NaN channels count
     /// as 0.
     pub fn from_rgb(rgb: Vec3) -> Self {
-        let c = |v: f32| if v > 0.0 { v } else { 0.0 };
-        let rgb = Vec3::new(c(rgb.x), c(rgb.y), c(rgb.z));
-        let scale = 2.0 * rgb.max_element();
-        if !(scale > 0.0 && scale.is_finite()) {
-            return Self {
-                scale: 0.0,
-                shape: RgbSigmoid::grey(0.0),
-            };
-        }
-        Self {
-            scale,
-            shape: RgbSigmoid::from_rgb(rgb / scale),
-        }
+        Self(RgbUnbounded::from_rgb(rgb))
     }
 
     /// Spectral radiance at `lambda` nm.
     pub fn eval(&self, lambda: f32) -> f32 {
-        self.scale * self.shape.eval(lambda) * d65(lambda) / D65_LUMINANCE
+        self.0.eval(lambda) * d65(lambda) / D65_LUMINANCE
     }
 
     /// [`RgbIlluminant::eval`] at four wavelengths.
     #[inline]
     pub fn eval4(&self, lambda: [f32; 4]) -> [f32; 4] {
-        let s = self.shape.eval4(lambda);
-        let k = self.scale / D65_LUMINANCE;
-        std::array::from_fn(|i| k * s[i] * d65(lambda[i]))
+        let s = self.0.eval4(lambda);
+        std::array::from_fn(|i| s[i] * d65(lambda[i]) / D65_LUMINANCE)
     }
 }
 
@@ -285,10 +269,9 @@ impl Spectrum for RgbIlluminant {
     }
 }
 
-/// A non-negative, unbounded RGB quantity (a medium's σa or σs) as a
-/// smooth spectrum: `scale`·σ(…) with `scale` = 2·max(rgb), like
-/// [`RgbIlluminant`] without the illuminant (pbrt-v4's
-/// `RGBUnboundedSpectrum`).
+/// A non-negative, unbounded RGB quantity (a medium's σa or σs, and the
+/// shape of an [`RgbIlluminant`]) as a smooth spectrum: `scale`·σ(…) with
+/// `scale` = 2·max(rgb) (pbrt-v4's `RGBUnboundedSpectrum`).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RgbUnbounded {
     scale: f32,
