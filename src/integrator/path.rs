@@ -360,6 +360,9 @@ pub fn shade<T: Transport, const MOTION: bool, const MEDIA: bool>(
     let mut shadow = None;
     match material {
         Material::Diffuse { albedo } => {
+            // Evaluated once for the light sample and the bounce (spectrally it is a sigmoid
+            // at four wavelengths, not free).
+            let refl = T::reflectance(ctx, mat, albedo, tex_albedo.is_some(), &s.lambda);
             if ctx.nee {
                 let u_sel = ctx.sampler.get_1d(pixel, index, dim);
                 let u_l = ctx.sampler.get_2d(pixel, index, dim + 1);
@@ -369,9 +372,7 @@ pub fn shade<T: Transport, const MOTION: bool, const MEDIA: bool>(
                     let cos = ls.wi.dot(nsf);
                     if cos > 0.0 && ls.wi.dot(nf) > 0.0 {
                         let bsdf_pdf = cos * std::f32::consts::FRAC_1_PI;
-                        let f = T::reflectance(ctx, mat, albedo, tex_albedo.is_some(), &s.lambda)
-                            * std::f32::consts::FRAC_1_PI
-                            * cos;
+                        let f = refl * std::f32::consts::FRAC_1_PI * cos;
                         let w = if ls.delta {
                             1.0
                         } else {
@@ -414,7 +415,7 @@ pub fn shade<T: Transport, const MOTION: bool, const MEDIA: bool>(
                 s.alive = false;
                 return shadow;
             }
-            s.beta *= T::reflectance(ctx, mat, albedo, tex_albedo.is_some(), &s.lambda);
+            s.beta *= refl;
             s.prev_pdf = sampling::cosine_hemisphere_pdf(local.z);
             s.specular = false;
             s.ray = Ray::new(offset_ray_origin(sp.p, nf), wi);

@@ -258,8 +258,21 @@ impl RgbIlluminant {
     /// [`RgbIlluminant::eval`] at four wavelengths.
     #[inline]
     pub fn eval4(&self, lambda: [f32; 4]) -> [f32; 4] {
+        self.eval4_lit(lambda, Self::illuminant4(lambda))
+    }
+
+    /// The illuminant every RGB emitter is a multiple of (D65 of luminance 1) at four
+    /// wavelengths: a path computes it once and passes it to [`RgbIlluminant::eval4_lit`].
+    #[inline]
+    pub fn illuminant4(lambda: [f32; 4]) -> [f32; 4] {
+        lambda.map(|l| d65(l) / D65_LUMINANCE)
+    }
+
+    /// [`RgbIlluminant::eval4`] with the illuminant already evaluated at `lambda`.
+    #[inline]
+    pub fn eval4_lit(&self, lambda: [f32; 4], illuminant: [f32; 4]) -> [f32; 4] {
         let s = self.0.eval4(lambda);
-        std::array::from_fn(|i| s[i] * d65(lambda[i]) / D65_LUMINANCE)
+        std::array::from_fn(|i| s[i] * illuminant[i])
     }
 }
 
