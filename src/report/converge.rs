@@ -403,6 +403,19 @@ fn time_to(points: &[(f64, f64)], target: f64) -> String {
     }
 }
 
+/// relMSE at `t` seconds, interpolated log–log between the rungs that straddle it.
+fn error_at(points: &[(f64, f64)], t: f64) -> Option<f64> {
+    points.windows(2).find_map(|w| {
+        let ((t0, e0), (t1, e1)) = (w[0], w[1]);
+        if t0 <= t && t <= t1 && t0 > 0.0 && t1 > t0 && e0 > 0.0 && e1 > 0.0 {
+            let f = (t.log10() - t0.log10()) / (t1.log10() - t0.log10());
+            Some(10f64.powf(e0.log10() + f * (e1.log10() - e0.log10())))
+        } else {
+            None
+        }
+    })
+}
+
 fn summary(scene: &Path, rows: &[Row], names: &[String], ref_est: Option<f64>) -> String {
     let mut s = format!("# Convergence of `{}`\n\n", scene.display());
     match ref_est {
@@ -413,14 +426,23 @@ fn summary(scene: &Path, rows: &[Row], names: &[String], ref_est: Option<f64>) -
         .unwrap(),
         None => writeln!(s, "Reference: supplied with `--reference`.\n").unwrap(),
     }
-    s.push_str("| configuration | rungs | slope (log relMSE / log s) | time to 1 % relMSE | time to 0.1 % relMSE | last relMSE | note |\n");
-    s.push_str("|---|---|---|---|---|---|---|\n");
-    for name in names {
-        let pts: Vec<(f64, f64)> = rows
-            .iter()
+    let points = |name: &String| -> Vec<(f64, f64)> {
+        rows.iter()
             .filter(|r| &r.config == name)
             .map(|r| (r.seconds, r.relmse))
-            .collect();
+            .collect()
+    };
+    // Error at equal time: at the longest time every configuration's ladder reached.
+    let equal_t = names
+        .iter()
+        .filter_map(|n| points(n).last().map(|p| p.0))
+        .fold(f64::INFINITY, f64::min);
+    s.push_str(&format!(
+        "| configuration | rungs | slope (log relMSE / log s) | time to 1 % relMSE | time to 0.1 % relMSE | relMSE at {equal_t:.2} s (equal time) | last relMSE | note |\n"
+    ));
+    s.push_str("|---|---|---|---|---|---|---|---|\n");
+    for name in names {
+        let pts = points(name);
         let slope = fit(&pts).map_or("–".into(), |(k, _)| format!("{k:.2}"));
         // Unbiased Monte Carlo error falls as 1/time (slope −1); a bias flattens the tail.
         let tail = if pts.len() >= 3 {
@@ -440,12 +462,13 @@ fn summary(scene: &Path, rows: &[Row], names: &[String], ref_est: Option<f64>) -
         };
         writeln!(
             s,
-            "| {} | {} | {} | {} | {} | {} | {} |",
+            "| {} | {} | {} | {} | {} | {} | {} | {} |",
             name,
             pts.len(),
             slope,
             reach(0.01),
             reach(0.001),
+            error_at(&pts, equal_t).map_or("–".into(), |e| format!("{e:.2e}")),
             pts.last().map_or("–".into(), |p| format!("{:.2e}", p.1)),
             note
         )
@@ -465,6 +488,12 @@ mod tests {
         let (slope, b) = fit(&pts).unwrap();
         assert!((slope + 1.0).abs() < 1e-12 && (b - 0.5f64.log10()).abs() < 1e-12);
         assert_eq!(time_to(&pts, 0.1), "5.000 s");
+        // Halfway between rungs in log time is halfway in log error on a power law.
+        let e = error_at(&pts, 2f64.powf(2.5)).unwrap();
+        assert!((e / (0.5 / 2f64.powf(2.5)) - 1.0).abs() < 1e-12);
+        let last = error_at(&pts, 32.0).unwrap();
+        assert!((last / (0.5 / 32.0) - 1.0).abs() < 1e-12);
+        assert_eq!(error_at(&pts, 64.0), None);
     }
 
     #[test]
