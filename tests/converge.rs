@@ -38,16 +38,21 @@ fn converge_writes_csv_plot_and_summary_with_falling_error() {
     }
     let csv = std::fs::read_to_string(d.path().join("converge.csv")).unwrap();
     let mut lines = csv.lines();
-    assert_eq!(lines.next(), Some("config,spp,seconds,rmse,relmse,ssim"));
+    assert_eq!(
+        lines.next(),
+        Some("config,spp,seconds,rmse,relmse,ssim,relmse_trimmed")
+    );
     let rows: Vec<Vec<String>> = lines
         .map(|l| l.split(',').map(str::to_string).collect())
         .collect();
     assert_eq!(rows.len(), 3);
     let num = |r: &Vec<String>, i: usize| r[i].parse::<f64>().unwrap();
     for r in &rows {
-        assert_eq!(r.len(), 6);
+        assert_eq!(r.len(), 7);
         assert!(num(r, 2) > 0.0 && num(r, 3) >= 0.0 && num(r, 4) >= 0.0);
         assert!((0.0..=1.0).contains(&num(r, 5)));
+        // Dropping the worst pixels can only lower the mean.
+        assert!(num(r, 6) >= 0.0 && num(r, 6) <= num(r, 4), "{r:?}");
     }
     assert_eq!(
         rows.iter().map(|r| num(r, 1) as u32).collect::<Vec<_>>(),
