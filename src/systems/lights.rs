@@ -29,6 +29,9 @@ pub struct LightSample {
     pub pdf: f32,
     /// A point or spot light: no other technique can find it, so MIS gives it full weight.
     pub delta: bool,
+    /// Area lights: the density per unit area, with the selection probability, with which
+    /// [`Lights::pick_equiangular`] picks this point (uniform by area); 0 for other lights.
+    pub area_density: f32,
     /// Which emitter, for spectral transport to evaluate its spectrum.
     pub source: LightSource,
 }
@@ -86,6 +89,7 @@ impl Lights {
                     radiance: l,
                     pdf: pmf * crate::sampling::uniform_sphere_pdf(),
                     delta: false,
+                    area_density: 0.0,
                     source: LightSource::Environment,
                 })
             }
@@ -101,6 +105,7 @@ impl Lights {
                     radiance,
                     pdf: pmf,
                     delta: true,
+                    area_density: 0.0,
                     source: LightSource::Point {
                         light: i as u32,
                         scale,
@@ -140,6 +145,7 @@ impl Lights {
                     radiance,
                     pdf: pmf * s.pdf,
                     delta: false,
+                    area_density: pmf / emitter_area(prims, prim),
                     source: LightSource::Area { material, tex },
                 })
             }
@@ -176,18 +182,100 @@ impl Lights {
         }
     }
 
-    /// Chooses a light exactly as `sample` does; returns it when it is a point or spot light
-    /// (the lights equiangular sampling aims at), with its selection probability.
+    /// Chooses a light exactly as `sample` does (same `u_select`) and returns what
+    /// equiangular sampling aims at: a point or spot light, or a point on an area light drawn
+    /// uniformly by area from `u` (before any distance along the ray is known, so it cannot
+    /// depend on the scattering point). The environment gives `None`.
     #[inline]
-    pub fn pick_point(&self, u_select: f32) -> Option<(u32, crate::components::PointLight, f32)> {
+    pub fn pick_equiangular<const MOTION: bool>(
+        &self,
+        prims: &Primitives,
+        u_select: f32,
+        u: Vec2,
+        time: f32,
+    ) -> Option<EquiangularTarget> {
         if self.lights.is_empty() {
             return None;
         }
         let (i, pmf) = self.table.sample(u_select);
         match self.lights[i] {
-            LightKind::Point(p) => Some((i as u32, p, pmf)),
-            _ => None,
+            LightKind::Point(light) => Some(EquiangularTarget::Point {
+                index: i as u32,
+                light,
+                pmf,
+            }),
+            LightKind::Area(prim) => {
+                let l = prims.local[prim as usize] as usize;
+                let (p, n) = match prims.kind[prim as usize] {
+                    PrimKind::Sphere => {
+                        let s = &prims.spheres[l];
+                        let n = crate::sampling::square_to_uniform_sphere(u);
+                        (s.center + n * s.radius, n)
+                    }
+                    PrimKind::Rect | PrimKind::Disk => {
+                        let q = &prims.planars[l];
+                        let (a, b) = if prims.kind[prim as usize] == PrimKind::Disk {
+                            let d = crate::sampling::square_to_uniform_disk_concentric(u);
+                            (d.x, d.y)
+                        } else {
+                            (2.0 * u.x - 1.0, 2.0 * u.y - 1.0)
+                        };
+                        (q.center + a * q.u + b * q.v, q.n)
+                    }
+                    PrimKind::Box | PrimKind::Revolution | PrimKind::Mesh => return None,
+                };
+                // A moving emitter is sampled in its rest pose; a rigid map keeps areas.
+                let (p, n) = match prims.motion_of(prim) {
+                    Some(m) if MOTION => (m.point_to_world(p, time), m.vector_to_world(n, time)),
+                    _ => (p, n),
+                };
+                Some(EquiangularTarget::Area {
+                    prim,
+                    p,
+                    n,
+                    density: pmf / emitter_area(prims, prim),
+                })
+            }
+            LightKind::Environment(_) => None,
         }
+    }
+
+    /// The light sample that the point `(q, n)` (position, normal) on area light `prim` makes as seen
+    /// from `p`: radiance emitted towards `p` and, as `pdf`, the solid-angle density with which
+    /// `sample` from `p` would have chosen it. `None` when nothing is emitted towards `p`.
+    #[inline]
+    pub fn area_seen_from<const MOTION: bool>(
+        &self,
+        prims: &Primitives,
+        prim: u32,
+        (q, n): (Vec3, Vec3),
+        p: Vec3,
+        time: f32,
+        textures: bool,
+    ) -> Option<LightSample> {
+        let wi = (q - p).normalize_or_zero();
+        let material = prims.material[prim as usize];
+        let mut m = prims.materials[material as usize];
+        let mut tex = None;
+        if textures && let Some(t) = prims.texture_of(prim) {
+            let motion = if MOTION { prims.motion_of(prim) } else { None };
+            let qr = motion.map_or(q, |mo| mo.point_to_rest(q, time));
+            if let Some(a) = t.albedo(prims.uv_at(prim, qr)) {
+                m = m.modulated(a);
+                tex = Some(a);
+            }
+        }
+        let radiance = emitted(&m, n, -wi);
+        (wi != Vec3::ZERO && radiance != Vec3::ZERO).then(|| LightSample {
+            wi,
+            point: Some((q, n)),
+            radiance,
+            pdf: self.pdf_area::<MOTION>(prims, prim, p, q, n, time),
+            delta: false,
+            area_density: self.table.pmf(prims.light[prim as usize] as usize)
+                / emitter_area(prims, prim),
+            source: LightSource::Area { material, tex },
+        })
     }
 
     /// Density of sampling direction `wi` towards the environment.
@@ -196,6 +284,36 @@ impl Lights {
         self.environment.map_or(0.0, |i| {
             self.table.pmf(i as usize) * crate::sampling::uniform_sphere_pdf()
         })
+    }
+}
+
+/// What equiangular distance sampling aims at, chosen by [`Lights::pick_equiangular`].
+#[derive(Clone, Copy, Debug)]
+pub enum EquiangularTarget {
+    /// Point or spot light `index`, chosen with probability `pmf`.
+    Point {
+        index: u32,
+        light: crate::components::PointLight,
+        pmf: f32,
+    },
+    /// Point `p` (normal `n`) on area light `prim`, drawn with `density` per unit area
+    /// (including the light's selection probability).
+    Area {
+        prim: u32,
+        p: Vec3,
+        n: Vec3,
+        density: f32,
+    },
+}
+
+/// World-space area of an emissive primitive (a rigid motion keeps it).
+#[inline]
+fn emitter_area(prims: &Primitives, prim: u32) -> f32 {
+    let l = prims.local[prim as usize] as usize;
+    match prims.kind[prim as usize] {
+        PrimKind::Sphere => prims.spheres[l].area(),
+        PrimKind::Rect | PrimKind::Disk => prims.planars[l].area(),
+        PrimKind::Box | PrimKind::Revolution | PrimKind::Mesh => f32::INFINITY,
     }
 }
 
