@@ -9,7 +9,7 @@ use crate::medium::{DistanceSample, Equiangular};
 use crate::sampling::{self, Sampler};
 use crate::scene_file::schema::{Fresnel, LightSampling};
 use crate::spectrum::Channels;
-use crate::systems::lights::EquiangularTarget;
+use crate::systems::lights::{EquiangularTarget, LightSource};
 use crate::systems::primitives::NO_MEDIUM;
 use crate::systems::{Hit, RenderScene, primitives::emitted};
 use glam::{Vec2, Vec3};
@@ -509,7 +509,8 @@ struct Segment {
 /// Three techniques produce it:
 /// - (a) free flight, then a light sample from x_t: `p_a = p_ff(t) · p_light(ω) · G`,
 /// - (b) free flight, then a phase sample that hits y: `p_b = p_ff(t) · p_phase(ω) · G`,
-/// - (c) here: y uniform by area first, then t equiangular towards y: `p_c = p_A(y) · p_eq(t|y)`,
+/// - (c) here: y first (by area, see `Lights::pick_equiangular`), then t equiangular towards
+///   y: `p_c = p_A(y) · p_eq(t|y)`,
 ///
 /// with `G = |cos θ_y| / |y − x_t|²`. (a) and (b) keep the power-heuristic weights they have
 /// without equiangular sampling, `w_b = p_b² / (p_a² + p_b²)`, and (a) hands part of its
@@ -531,8 +532,12 @@ fn equiangular_nee<T: Transport, const MOTION: bool>(
     let prims = &ctx.scene.prims;
     let target = lights.pick_equiangular::<MOTION>(
         prims,
-        ctx.sampler.get_1d(pixel, index, dim + 8),
-        ctx.sampler.get_2d(pixel, index, dim + 10),
+        &s.ray,
+        t_hit,
+        (
+            ctx.sampler.get_1d(pixel, index, dim + 8),
+            ctx.sampler.get_2d(pixel, index, dim + 10),
+        ),
         s.time,
     )?;
     let u_t = ctx.sampler.get_1d(pixel, index, dim + 9);
@@ -637,23 +642,30 @@ fn scatter_in_medium<T: Transport, const MOTION: bool>(
                 .sample::<MOTION>(prims, p, u_sel, u_l, s.time, ctx.textures)
         {
             let ph = med.phase(wo, ls.wi);
-            let w = match ls.point {
+            let w = match (ls.point, ls.source) {
                 // The equiangular technique also produces this point light's scattering:
                 // weight by the two distance densities.
-                Some((q, _)) if ls.delta && ctx.equiangular => {
+                (Some((q, _)), _) if ls.delta && ctx.equiangular => {
                     Equiangular::new(seg.ray.o, seg.ray.d, 0.0, seg.t_hit, q)
                         .map_or(1.0, |eq| seg.p_ff / (seg.p_ff + eq.pdf(seg.t)))
                 }
                 _ if ls.delta => 1.0,
                 // An area light: (a) of `equiangular_nee`'s three techniques.
-                Some((q, nq)) if ctx.equiangular && ls.area_density > 0.0 => {
+                (Some((q, nq)), LightSource::Area { prim, .. }) if ctx.equiangular => {
                     let d = q - p;
                     let d2 = d.length_squared();
                     let g = nq.dot(d).abs() / (d2 * d2.sqrt());
                     let p_a = seg.p_ff * ls.pdf * g;
                     let p_c = Equiangular::new(seg.ray.o, seg.ray.d, 0.0, seg.t_hit, q)
                         .map_or(0.0, |eq| eq.pdf(seg.t))
-                        * ls.area_density;
+                        * ctx.scene.lights.equiangular_area_density::<MOTION>(
+                            &ctx.scene.prims,
+                            prim,
+                            nq,
+                            &seg.ray,
+                            seg.t_hit,
+                            s.time,
+                        );
                     let share = p_a / (p_a + p_c);
                     power_heuristic(ls.pdf, ph) * if share.is_finite() { share } else { 1.0 }
                 }

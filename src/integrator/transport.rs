@@ -354,7 +354,7 @@ impl Transport for Spectral {
     #[inline]
     fn light_radiance(ctx: &Ctx, ls: &LightSample, lam: &Wavelengths) -> SampledSpectrum {
         match ls.source {
-            LightSource::Area { material, tex } => {
+            LightSource::Area { material, tex, .. } => {
                 Self::emission(ctx, material, ls.radiance, tex, lam)
             }
             LightSource::Point { light, scale } => {

@@ -29,9 +29,6 @@ pub struct LightSample {
     pub pdf: f32,
     /// A point or spot light: no other technique can find it, so MIS gives it full weight.
     pub delta: bool,
-    /// Area lights: the density per unit area, with the selection probability, with which
-    /// [`Lights::pick_equiangular`] picks this point (uniform by area); 0 for other lights.
-    pub area_density: f32,
     /// Which emitter, for spectral transport to evaluate its spectrum.
     pub source: LightSource,
 }
@@ -39,10 +36,12 @@ pub struct LightSample {
 /// The emitter a light sample came from.
 #[derive(Clone, Copy, Debug)]
 pub enum LightSource {
-    /// An area light of material `material`, its colour modulated by the texture albedo `tex`.
+    /// Area light `prim` of material `material`, its colour modulated by the texture albedo
+    /// `tex`.
     Area {
         material: u32,
         tex: Option<Vec3>,
+        prim: u32,
     },
     /// Point or spot light `light` (light index), its intensity scaled by falloff / d².
     Point {
@@ -89,7 +88,6 @@ impl Lights {
                     radiance: l,
                     pdf: pmf * crate::sampling::uniform_sphere_pdf(),
                     delta: false,
-                    area_density: 0.0,
                     source: LightSource::Environment,
                 })
             }
@@ -105,7 +103,6 @@ impl Lights {
                     radiance,
                     pdf: pmf,
                     delta: true,
-                    area_density: 0.0,
                     source: LightSource::Point {
                         light: i as u32,
                         scale,
@@ -145,8 +142,11 @@ impl Lights {
                     radiance,
                     pdf: pmf * s.pdf,
                     delta: false,
-                    area_density: pmf / emitter_area(prims, prim),
-                    source: LightSource::Area { material, tex },
+                    source: LightSource::Area {
+                        material,
+                        tex,
+                        prim,
+                    },
                 })
             }
         }
@@ -183,15 +183,18 @@ impl Lights {
     }
 
     /// Chooses a light exactly as `sample` does (same `u_select`) and returns what
-    /// equiangular sampling aims at: a point or spot light, or a point on an area light drawn
-    /// uniformly by area from `u` (before any distance along the ray is known, so it cannot
-    /// depend on the scattering point). The environment gives `None`.
+    /// equiangular sampling along the segment `ray` (unit direction) up to `t_max` aims at: a
+    /// point or spot light, or a point on an area light drawn from `u` before any distance
+    /// along the ray is known (so it cannot depend on the scattering point). Planar emitters
+    /// are sampled uniformly by area; spheres uniformly by area over the half facing the
+    /// segment (see [`sphere_facing_axis`]). The environment gives `None`.
     #[inline]
     pub fn pick_equiangular<const MOTION: bool>(
         &self,
         prims: &Primitives,
-        u_select: f32,
-        u: Vec2,
+        ray: &crate::geometry::Ray,
+        t_max: f32,
+        (u_select, u): (f32, Vec2),
         time: f32,
     ) -> Option<EquiangularTarget> {
         if self.lights.is_empty() {
@@ -206,11 +209,23 @@ impl Lights {
             }),
             LightKind::Area(prim) => {
                 let l = prims.local[prim as usize] as usize;
-                let (p, n) = match prims.kind[prim as usize] {
+                // A moving emitter is sampled in its rest pose; a rigid map keeps areas.
+                let motion = if MOTION { prims.motion_of(prim) } else { None };
+                let (p, n, density) = match prims.kind[prim as usize] {
                     PrimKind::Sphere => {
                         let s = &prims.spheres[l];
-                        let n = crate::sampling::square_to_uniform_sphere(u);
-                        (s.center + n * s.radius, n)
+                        let mut n = crate::sampling::square_to_uniform_sphere(u);
+                        let axis = sphere_facing_axis(s, &rest_ray(motion, ray, time), t_max);
+                        let share = match axis {
+                            Some(a) => {
+                                if n.dot(a) < 0.0 {
+                                    n = -n;
+                                }
+                                0.5
+                            }
+                            None => 1.0,
+                        };
+                        (s.center + n * s.radius, n, pmf / (share * s.area()))
                     }
                     PrimKind::Rect | PrimKind::Disk => {
                         let q = &prims.planars[l];
@@ -220,23 +235,57 @@ impl Lights {
                         } else {
                             (2.0 * u.x - 1.0, 2.0 * u.y - 1.0)
                         };
-                        (q.center + a * q.u + b * q.v, q.n)
+                        (q.center + a * q.u + b * q.v, q.n, pmf / q.area())
                     }
                     PrimKind::Box | PrimKind::Revolution | PrimKind::Mesh => return None,
                 };
-                // A moving emitter is sampled in its rest pose; a rigid map keeps areas.
-                let (p, n) = match prims.motion_of(prim) {
-                    Some(m) if MOTION => (m.point_to_world(p, time), m.vector_to_world(n, time)),
-                    _ => (p, n),
+                let (p, n) = match motion {
+                    Some(m) => (m.point_to_world(p, time), m.vector_to_world(n, time)),
+                    None => (p, n),
                 };
                 Some(EquiangularTarget::Area {
                     prim,
                     p,
                     n,
-                    density: pmf / emitter_area(prims, prim),
+                    density,
                 })
             }
             LightKind::Environment(_) => None,
+        }
+    }
+
+    /// Density per unit area, with the selection probability, with which
+    /// [`Self::pick_equiangular`] for the segment `ray` up to `t_max` picks the point of
+    /// normal `n` on area light `prim`.
+    #[inline]
+    pub fn equiangular_area_density<const MOTION: bool>(
+        &self,
+        prims: &Primitives,
+        prim: u32,
+        n: Vec3,
+        ray: &crate::geometry::Ray,
+        t_max: f32,
+        time: f32,
+    ) -> f32 {
+        let pmf = self.table.pmf(prims.light[prim as usize] as usize);
+        let l = prims.local[prim as usize] as usize;
+        match prims.kind[prim as usize] {
+            PrimKind::Sphere => {
+                let s = &prims.spheres[l];
+                let motion = if MOTION { prims.motion_of(prim) } else { None };
+                match sphere_facing_axis(s, &rest_ray(motion, ray, time), t_max) {
+                    Some(a) => {
+                        let n = motion.map_or(n, |m| m.vector_to_rest(n, time));
+                        if n.dot(a) >= 0.0 {
+                            pmf / (0.5 * s.area())
+                        } else {
+                            0.0
+                        }
+                    }
+                    None => pmf / s.area(),
+                }
+            }
+            _ => pmf / emitter_area(prims, prim),
         }
     }
 
@@ -272,9 +321,11 @@ impl Lights {
             radiance,
             pdf: self.pdf_area::<MOTION>(prims, prim, p, q, n, time),
             delta: false,
-            area_density: self.table.pmf(prims.light[prim as usize] as usize)
-                / emitter_area(prims, prim),
-            source: LightSource::Area { material, tex },
+            source: LightSource::Area {
+                material,
+                tex,
+                prim,
+            },
         })
     }
 
@@ -304,6 +355,34 @@ pub enum EquiangularTarget {
         n: Vec3,
         density: f32,
     },
+}
+
+/// The ray in the rest pose of a moving primitive (itself when it does not move).
+#[inline]
+fn rest_ray(
+    motion: Option<&crate::geometry::RigidMotion>,
+    ray: &crate::geometry::Ray,
+    time: f32,
+) -> crate::geometry::Ray {
+    motion.map_or(*ray, |m| {
+        crate::geometry::Ray::new(m.point_to_rest(ray.o, time), m.vector_to_rest(ray.d, time))
+    })
+}
+
+/// The half of sphere `s` that equiangular sampling draws light points from for the segment
+/// `ray` (unit direction) up to `t_max`: the hemisphere facing the segment's point nearest
+/// the centre, where equiangular sampling puts most scattering points and whose visible cap
+/// is nearly that hemisphere (uniform points over the whole sphere would waste half on its
+/// far side). `None`, the whole sphere, when that point is not outside the sphere.
+#[inline]
+pub fn sphere_facing_axis(
+    s: &crate::geometry::Sphere,
+    ray: &crate::geometry::Ray,
+    t_max: f32,
+) -> Option<Vec3> {
+    let t = (s.center - ray.o).dot(ray.d).clamp(0.0, t_max);
+    let a = ray.at(t) - s.center;
+    (a.length_squared() > s.radius * s.radius && a.is_finite()).then_some(a)
 }
 
 /// World-space area of an emissive primitive (a rigid motion keeps it).
