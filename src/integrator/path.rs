@@ -5,10 +5,11 @@ use super::bsdf::{fresnel_dielectric, fresnel_schlick, reflect, refract};
 use super::transport::{MediumOps, SpectralData, Transport};
 use crate::components::Material;
 use crate::geometry::{Ray, offset_ray_origin, spawn_ray_to};
-use crate::medium::DistanceSample;
+use crate::medium::{DistanceSample, Equiangular};
 use crate::sampling::{self, Sampler};
 use crate::scene_file::schema::{Fresnel, LightSampling};
 use crate::spectrum::Channels;
+use crate::systems::lights::{EquiangularTarget, LightSource};
 use crate::systems::primitives::NO_MEDIUM;
 use crate::systems::{Hit, RenderScene, primitives::emitted};
 use glam::{Vec2, Vec3};
@@ -26,8 +27,8 @@ pub const DIM_BOUNCE: u32 = 8;
 pub const DIMS_PER_BOUNCE: u32 = 8;
 /// Medium segments take their dimensions from a separate range, 12 per segment: channel,
 /// distance, light choice, light point (2), phase direction (2), Russian roulette, and the
-/// equiangular technique's light choice and distance. A path may cross boundaries without
-/// scattering, so segments are counted apart from bounces.
+/// equiangular technique's light choice, distance and light point (2). A path may cross
+/// boundaries without scattering, so segments are counted apart from bounces.
 pub const DIM_MEDIA: u32 = 1 << 20;
 pub const DIMS_PER_SEGMENT: u32 = 12;
 
@@ -265,7 +266,7 @@ pub fn shade<T: Transport, const MOTION: bool, const MEDIA: bool>(
         let u_t = ctx.sampler.get_1d(pixel, index, dim + 1);
         let probs = s.beta;
         if ctx.equiangular && ctx.nee && s.depth < ctx.max_depth {
-            *extra = equiangular_nee::<T>(ctx, s, &med, t_hit, dim);
+            *extra = equiangular_nee::<T, MOTION>(ctx, s, &med, t_hit, dim);
         }
         match med.sample_distance(t_hit, u_c, u_t, probs) {
             DistanceSample::Pass { weight } => s.beta *= weight,
@@ -498,10 +499,29 @@ struct Segment {
 }
 
 /// Equiangular sampling (Kulla & Fajardo 2012): a scattering distance on the segment drawn
-/// towards a chosen point or spot light, whose single-scattering contribution is combined with
-/// free-flight sampling's by the balance heuristic over the two distance densities.
+/// towards a chosen light, whose single-scattering contribution is combined with the other
+/// techniques that produce the same path.
+///
+/// Point and spot lights: only free-flight distance + light sample also produces the path
+/// (t, light); the two are weighted by the balance heuristic over the two distance densities
+/// (the light choice probability is common to both).
+///
+/// Area lights: the path is the pair (t, y), y on the light, in the measure dt·dA(y).
+/// Three techniques produce it:
+/// - (a) free flight, then a light sample from x_t: `p_a = p_ff(t) · p_light(ω) · G`,
+/// - (b) free flight, then a phase sample that hits y: `p_b = p_ff(t) · p_phase(ω) · G`,
+/// - (c) here: y first (by area, see `Lights::pick_equiangular`), then t equiangular towards
+///   y: `p_c = p_A(y) · p_eq(t|y)`,
+///
+/// with `G = |cos θ_y| / |y − x_t|²`. (a) and (b) keep the power-heuristic weights they have
+/// without equiangular sampling, `w_b = p_b² / (p_a² + p_b²)`, and (a) hands part of its
+/// share to (c) by the balance heuristic: `w_a = (1 − w_b) p_a / (p_a + p_c)`,
+/// `w_c = (1 − w_b) p_c / (p_a + p_c)`. The three sum to 1 wherever any density is
+/// non-zero (where (b) is the only one, `w_b = 1`), so the sum is unbiased. Every factor is
+/// known at each technique's sample, and (b)'s weight does not involve (c), so emitters hit
+/// by chance need nothing about the segment they were reached from.
 #[inline]
-fn equiangular_nee<T: Transport>(
+fn equiangular_nee<T: Transport, const MOTION: bool>(
     ctx: &Ctx,
     s: &PathState<T>,
     med: &T::Med,
@@ -509,34 +529,93 @@ fn equiangular_nee<T: Transport>(
     dim: u32,
 ) -> Option<ShadowRequest<T::S>> {
     let (pixel, index) = (s.pixel, s.sample);
-    let (li, pl, pmf) = ctx
-        .scene
-        .lights
-        .pick_point(ctx.sampler.get_1d(pixel, index, dim + 8))?;
-    let eq = crate::medium::Equiangular::new(s.ray.o, s.ray.d, 0.0, t_hit, pl.position)?;
-    let (t, p_eq) = eq.sample(ctx.sampler.get_1d(pixel, index, dim + 9));
-    let x = s.ray.at(t);
-    let d = pl.position - x;
-    let d2 = d.length_squared();
-    let wi = d / d2.sqrt();
-    let radiance = T::point_radiance(ctx, li, pl.intensity, pl.falloff(-wi) / d2, &s.lambda);
-    let p_ff = med.distance_pdf(t, s.beta);
-    let contrib = s.beta
-        * med.sigma_s()
-        * med.transmittance(t)
-        * radiance
-        * (med.phase(-s.ray.d, wi) / (pmf * (p_eq + p_ff)));
-    (contrib != T::S::ZERO && contrib.is_finite()).then_some(ShadowRequest {
-        ray: Ray::new(x, d),
-        t_max: 1.0 - 1e-4,
-        contrib,
-        medium: s.medium,
-    })
+    let lights = &ctx.scene.lights;
+    let prims = &ctx.scene.prims;
+    let target = lights.pick_equiangular::<MOTION>(
+        prims,
+        &s.ray,
+        t_hit,
+        (
+            ctx.sampler.get_1d(pixel, index, dim + 8),
+            ctx.sampler.get_2d(pixel, index, dim + 10),
+        ),
+        s.time,
+    )?;
+    let u_t = ctx.sampler.get_1d(pixel, index, dim + 9);
+    let wo = -s.ray.d;
+    match target {
+        EquiangularTarget::Point {
+            index: li,
+            light: pl,
+            pmf,
+        } => {
+            let eq = Equiangular::new(s.ray.o, s.ray.d, 0.0, t_hit, pl.position)?;
+            let (t, p_eq) = eq.sample(u_t);
+            let x = s.ray.at(t);
+            let d = pl.position - x;
+            let d2 = d.length_squared();
+            let wi = d / d2.sqrt();
+            let radiance =
+                T::point_radiance(ctx, li, pl.intensity, pl.falloff(-wi) / d2, &s.lambda);
+            let p_ff = med.distance_pdf(t, s.beta);
+            let contrib = s.beta
+                * med.sigma_s()
+                * med.transmittance(t)
+                * radiance
+                * (med.phase(wo, wi) / (pmf * (p_eq + p_ff)));
+            (contrib != T::S::ZERO && contrib.is_finite()).then_some(ShadowRequest {
+                ray: Ray::new(x, d),
+                t_max: 1.0 - 1e-4,
+                contrib,
+                medium: s.medium,
+            })
+        }
+        EquiangularTarget::Area {
+            prim,
+            p: y,
+            n,
+            density,
+        } => {
+            let eq = Equiangular::new(s.ray.o, s.ray.d, 0.0, t_hit, y)?;
+            let (t, p_eq) = eq.sample(u_t);
+            let x = s.ray.at(t);
+            let ls =
+                lights.area_seen_from::<MOTION>(prims, prim, (y, n), x, s.time, ctx.textures)?;
+            let d = y - x;
+            let d2 = d.length_squared();
+            let g = n.dot(ls.wi).abs() / d2;
+            let ph = med.phase(wo, ls.wi);
+            let p_a = med.distance_pdf(t, s.beta) * ls.pdf * g;
+            let p_c = density * p_eq;
+            // f · w_c / p_c with f = β σs Tr(t) ph Le G (see above).
+            let w = power_heuristic(ls.pdf, ph) * g / (p_a + p_c);
+            let contrib = s.beta
+                * med.sigma_s()
+                * med.transmittance(t)
+                * T::light_radiance(ctx, &ls, &s.lambda)
+                * (ph * w);
+            (contrib != T::S::ZERO && contrib.is_finite()).then_some(ShadowRequest {
+                ray: shadow_ray_to_area(x, y, n),
+                t_max: 1.0,
+                contrib,
+                medium: s.medium,
+            })
+        }
+    }
+}
+
+/// A shadow ray from a point in a medium (on no surface: no offset at this end) to the point
+/// `q` (normal `nq`) on an emitter, stopping just off its surface on the side facing `p`.
+#[inline]
+fn shadow_ray_to_area(p: Vec3, q: Vec3, nq: Vec3) -> Ray {
+    let d = q - p;
+    let nt = if nq.dot(d) <= 0.0 { nq } else { -nq };
+    Ray::new(p, offset_ray_origin(q, nt) - p)
 }
 
 /// A scattering event inside a medium: next-event estimation through the phase function
-/// (MIS with phase sampling; for point and spot lights, balance-heuristic MIS with the
-/// equiangular technique), then a phase-sampled continuation.
+/// (MIS with phase sampling and with the equiangular technique, see [`equiangular_nee`]),
+/// then a phase-sampled continuation.
 #[inline]
 fn scatter_in_medium<T: Transport, const MOTION: bool>(
     ctx: &Ctx,
@@ -564,14 +643,33 @@ fn scatter_in_medium<T: Transport, const MOTION: bool>(
                 .sample::<MOTION>(prims, p, u_sel, u_l, s.time, ctx.textures)
         {
             let ph = med.phase(wo, ls.wi);
-            let w = match ls.point {
+            let w = match (ls.point, ls.source) {
                 // The equiangular technique also produces this point light's scattering:
                 // weight by the two distance densities.
-                Some((q, _)) if ls.delta && ctx.equiangular => {
-                    crate::medium::Equiangular::new(seg.ray.o, seg.ray.d, 0.0, seg.t_hit, q)
+                (Some((q, _)), _) if ls.delta && ctx.equiangular => {
+                    Equiangular::new(seg.ray.o, seg.ray.d, 0.0, seg.t_hit, q)
                         .map_or(1.0, |eq| seg.p_ff / (seg.p_ff + eq.pdf(seg.t)))
                 }
                 _ if ls.delta => 1.0,
+                // An area light: (a) of `equiangular_nee`'s three techniques.
+                (Some((q, nq)), LightSource::Area { prim, .. }) if ctx.equiangular => {
+                    let d = q - p;
+                    let d2 = d.length_squared();
+                    let g = nq.dot(d).abs() / (d2 * d2.sqrt());
+                    let p_a = seg.p_ff * ls.pdf * g;
+                    let p_c = Equiangular::new(seg.ray.o, seg.ray.d, 0.0, seg.t_hit, q)
+                        .map_or(0.0, |eq| eq.pdf(seg.t))
+                        * ctx.scene.lights.equiangular_area_density::<MOTION>(
+                            &ctx.scene.prims,
+                            prim,
+                            nq,
+                            &seg.ray,
+                            seg.t_hit,
+                            s.time,
+                        );
+                    let share = p_a / (p_a + p_c);
+                    power_heuristic(ls.pdf, ph) * if share.is_finite() { share } else { 1.0 }
+                }
                 _ => power_heuristic(ls.pdf, ph),
             };
             let contrib = s.beta * T::light_radiance(ctx, &ls, &s.lambda) * (ph * w / ls.pdf);
@@ -579,11 +677,7 @@ fn scatter_in_medium<T: Transport, const MOTION: bool>(
                 // A point in a medium lies on no surface: no offset at this end.
                 let (ray, t_max) = match ls.point {
                     Some((q, _)) if ls.delta => (Ray::new(p, q - p), 1.0 - 1e-4),
-                    Some((q, nq)) => {
-                        let d = q - p;
-                        let nt = if nq.dot(d) <= 0.0 { nq } else { -nq };
-                        (Ray::new(p, offset_ray_origin(q, nt) - p), 1.0)
-                    }
+                    Some((q, nq)) => (shadow_ray_to_area(p, q, nq), 1.0),
                     None => (Ray::new(p, ls.wi), f32::INFINITY),
                 };
                 shadow = Some(ShadowRequest {

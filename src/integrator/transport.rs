@@ -373,7 +373,7 @@ impl Transport for Spectral {
     #[inline]
     fn light_radiance(ctx: &Ctx, ls: &LightSample, lam: &HeroLambda) -> SampledSpectrum {
         match ls.source {
-            LightSource::Area { material, tex } => {
+            LightSource::Area { material, tex, .. } => {
                 Self::emission(ctx, material, ls.radiance, tex, lam)
             }
             LightSource::Point { light, scale } => {
