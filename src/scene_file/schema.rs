@@ -87,7 +87,7 @@ pub struct IntegratorSettings {
     pub wavelengths: Wavelengths,
     #[serde(default)]
     pub sampler: SamplerChoice,
-    /// In media, also sample scattering distances towards point and spot lights
+    /// In media, also sample scattering distances towards point, spot and area lights
     /// (equiangular sampling, combined with free-flight sampling by MIS).
     #[serde(default = "default_true")]
     pub equiangular: bool,
