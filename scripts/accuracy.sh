@@ -18,7 +18,14 @@ $p converge scenes/diamond_bunny.ron --size 96x72 --reference-spp 8192 --budget 
     --vary wavelengths=1,4 -o "$out/diamond_bunny" --quiet > /dev/null
 $p converge scenes/prism.ron --size 96x60 --reference-spp 16384 --budget "$budget" \
     --vary wavelengths=1,4 -o "$out/prism" --quiet > /dev/null
+# What hero sampling buys where no interface disperses: the Cornell box under a dim D65 sky
+# (a spectral emitter, so SPECTRAL is on and the reference is spectral too).
+$p converge scenes/cornell.ron --size 96x96 --reference-spp 4096 --budget "$budget" \
+    --set 'environment=Constant(Illuminant(spectrum: D65, scale: 0.05))' \
+    --vary wavelengths=1,4 -o "$out/cornell_spectral" --quiet > /dev/null
+# Effects absent (forced on to measure them) and present, one scene each at least.
 $p costs scenes/cornell.ron scenes/caustics.ron scenes/motion_blur.ron scenes/earth_dof.ron \
+    scenes/textures.ron scenes/god_rays.ron scenes/prism.ron \
     --size 128x128 --spp 8 --runs 5 > "$out/effect_costs.md"
 
 

@@ -11,6 +11,7 @@ for key, path in [("CORNELL", "assets/accuracy/cornell/summary.md"),
                   ("CAUSTICS", "assets/accuracy/caustics/summary.md"),
                   ("DIAMOND", "assets/accuracy/diamond_bunny/summary.md"),
                   ("PRISM", "assets/accuracy/prism/summary.md"),
+                  ("CORNELL_SPECTRAL", "assets/accuracy/cornell_spectral/summary.md"),
                   ("COSTS", "assets/accuracy/effect_costs.md")]:
     block = f"<!-- {key} -->\n{table(path)}\n<!-- /{key} -->"
     text = re.sub(rf"<!-- {key} -->.*?<!-- /{key} -->|FIGURES_{key}", lambda _: block, text, flags=re.S)
