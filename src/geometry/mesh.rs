@@ -440,6 +440,16 @@ impl TriangleMesh {
         &self.stats
     }
 
+    /// The mesh's kd-tree.
+    pub fn tree(&self) -> &KdTree {
+        &self.tree
+    }
+
+    /// Builds the mesh's kd-tree again (with other parameters, or to time the build alone).
+    pub fn build_tree(&self, params: &KdParams) -> KdTree {
+        KdTree::build(&TriBoxes(&self.tris), params)
+    }
+
     pub fn triangle_count(&self) -> usize {
         self.tris.len()
     }
@@ -705,9 +715,10 @@ fn is_closed_surface(indices: &[[u32; 3]], weld: &[u32]) -> bool {
 }
 
 /// The constants of the watertight test for one ray: the translation to its origin and the
-/// permute-and-shear rows that carry the direction onto +z (Woop et al. 2013).
+/// permute-and-shear rows that carry the direction onto +z (Woop et al. 2013). Public so that
+/// other acceleration structures can be measured with the same triangle test.
 #[derive(Clone, Copy, Debug)]
-struct RayFrame {
+pub struct RayFrame {
     o: Vec3,
     /// Rows of the permute-and-shear: `x' = p[kx] − Sx p[kz]`, `y' = p[ky] − Sy p[kz]`,
     /// `z' = Sz p[kz]`. As dot products with these rows (one 1, one −S, one 0; or one Sz) they
@@ -721,8 +732,9 @@ struct RayFrame {
 }
 
 impl RayFrame {
+    /// `None` for a ray with a zero or non-finite direction or a non-finite origin.
     #[inline]
-    fn new(ray: &Ray) -> Option<Self> {
+    pub fn new(ray: &Ray) -> Option<Self> {
         let d = ray.d;
         if !d.is_finite() || !ray.o.is_finite() || d == Vec3::ZERO {
             return None;
@@ -759,7 +771,7 @@ impl RayFrame {
 
     /// `(t, b1, b2)` of a hit with `t` in (0, t_max).
     #[inline]
-    fn hit(&self, tri: &[Vec3; 3], t_max: f32) -> Option<(f32, f32, f32)> {
+    pub fn hit(&self, tri: &[Vec3; 3], t_max: f32) -> Option<(f32, f32, f32)> {
         let a = tri[0] - self.o;
         let b = tri[1] - self.o;
         let c = tri[2] - self.o;

@@ -183,6 +183,44 @@ impl KdTree {
         &self.stats
     }
 
+    /// Expected cost of a random ray through the root box under `params`' cost model: each
+    /// node's traversal or intersection cost weighted by its cell's surface area over the
+    /// root's. Compares the quality of trees over the same primitives.
+    pub fn sah_cost(&self, params: &KdParams) -> f64 {
+        if self.nodes.is_empty() {
+            return 0.0;
+        }
+        let root = f64::from(self.bounds.surface_area());
+        if root <= 0.0 {
+            return 0.0;
+        }
+        let mut total = 0.0;
+        let mut stack = vec![(0usize, self.bounds)];
+        while let Some((i, cell)) = stack.pop() {
+            let n = self.nodes[i];
+            let w = f64::from(cell.surface_area()) / root;
+            if n.is_leaf() {
+                total += w * f64::from(params.intersect_cost) * f64::from(n.prim_count());
+                continue;
+            }
+            total += w * f64::from(params.traversal_cost);
+            let (mut below, mut above) = (cell, cell);
+            below.max[n.axis()] = n.split();
+            above.min[n.axis()] = n.split();
+            stack.push((i + 1, below));
+            stack.push((n.above() as usize, above));
+        }
+        total
+    }
+
+    /// The nodes' packed words and the primitive index array, to compare trees exactly.
+    pub fn raw(&self) -> (Vec<[u32; 2]>, &[u32]) {
+        (
+            self.nodes.iter().map(|n| n.words()).collect(),
+            &self.indices,
+        )
+    }
+
     /// The primitives of a leaf node, which must be one of `self.nodes`.
     #[inline]
     fn leaf_prims<'a>(&'a self, leaf: &'a KdNode) -> &'a [u32] {

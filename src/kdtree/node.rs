@@ -67,6 +67,11 @@ impl KdNode {
         self.flags >> 2
     }
 
+    /// Payload and flags, for exact comparisons of trees.
+    pub fn words(&self) -> [u32; 2] {
+        [self.payload, self.flags]
+    }
+
     /// The inline primitive (count 1) or the run offset (count > 1), by reference so that a
     /// one-primitive leaf can be handed out as a one-element slice.
     #[inline]
