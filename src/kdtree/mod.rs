@@ -48,6 +48,9 @@ pub struct KdParams {
     pub max_leaf_prims: u32,
     /// Depth limit; `None` picks 8 + 1.3 log2(N). Clamped to [`MAX_DEPTH`].
     pub max_depth: Option<u32>,
+    /// Nodes with more primitive references than this pick their split from binned counts
+    /// (and build their children in parallel when large); smaller ones sweep exact events.
+    pub binned_above: usize,
 }
 
 impl Default for KdParams {
@@ -59,6 +62,7 @@ impl Default for KdParams {
             empty_bonus: 0.5,
             max_leaf_prims: 1,
             max_depth: None,
+            binned_above: 4096,
         }
     }
 }
@@ -74,7 +78,7 @@ impl KdParams {
 }
 
 /// What the builder needs to know of the primitives: it knows boxes, never shapes.
-pub trait KdPrimitives {
+pub trait KdPrimitives: Sync {
     fn len(&self) -> usize;
 
     fn is_empty(&self) -> bool {
@@ -90,6 +94,18 @@ pub trait KdPrimitives {
     /// later); default: bounds ∩ node. An empty box says the primitive misses the node.
     fn clipped_bounds(&self, i: u32, node: &Aabb) -> Aabb {
         self.bounds(i).intersection(node)
+    }
+
+    /// [`KdPrimitives::clipped_bounds`] for both children of `node` split at `pos` on `axis`
+    /// (below, above); an implementation may clip to the node once and split the result.
+    fn split_bounds(&self, i: u32, node: &Aabb, axis: usize, pos: f32) -> (Aabb, Aabb) {
+        let (mut below, mut above) = (*node, *node);
+        below.max[axis] = pos;
+        above.min[axis] = pos;
+        (
+            self.clipped_bounds(i, &below),
+            self.clipped_bounds(i, &above),
+        )
     }
 }
 
