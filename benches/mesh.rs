@@ -86,6 +86,25 @@ fn builds(c: &mut Criterion) {
     let mut g = c.benchmark_group("kd_build");
     g.sample_size(10);
     let params = TriangleMesh::kd_params();
+    // The exact event sweep everywhere (the builder before binning), on the meshes where it
+    // takes seconds rather than tens of seconds.
+    let exact = KdParams {
+        binned_above: usize::MAX,
+        ..params
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    for (name, m) in meshes.iter().filter(|(n, _)| n.starts_with("bunny")) {
+        eprintln!(
+            "kd_build/{name}: exact events everywhere: SAH cost {:.2}",
+            m.build_tree(&exact).sah_cost(&params)
+        );
+        g.bench_function(format!("{name}_exact_events_1t"), |b| {
+            b.iter(|| pool.install(|| m.build_tree(&exact)))
+        });
+    }
     for threads in [1, 2] {
         let pool = rayon::ThreadPoolBuilder::new()
             .num_threads(threads)
@@ -181,6 +200,19 @@ fn versus_obvhs(
             Triangle { v0, v1, v2 }
         })
         .collect();
+    // The same mesh with the exact event sweep everywhere: the tree the builder made before
+    // binning, to compare trees on the same rays.
+    let exact = TriangleMesh::with_params(
+        mesh.positions().to_vec(),
+        mesh.indices().to_vec(),
+        Some(mesh.normals().to_vec()),
+        mesh.uvs().map(<[Vec2]>::to_vec),
+        &KdParams {
+            binned_above: usize::MAX,
+            ..TriangleMesh::kd_params()
+        },
+    )
+    .unwrap();
     let bvh = build_bvh2_from_tris(
         &tris,
         BvhBuildParams::medium_build(),
@@ -223,6 +255,13 @@ fn versus_obvhs(
                     .count()
             })
         });
+        g.bench_function(format!("closest_{name}_prism_kd_exact_build"), |b| {
+            b.iter(|| {
+                rays.iter()
+                    .filter(|r| exact.intersect(r, t_max).is_some())
+                    .count()
+            })
+        });
         g.bench_function(format!("closest_{name}_obvhs_own_test"), |b| {
             b.iter(|| {
                 rays.iter()
@@ -253,6 +292,9 @@ fn versus_obvhs(
         });
         g.bench_function(format!("any_{name}_prism_kd"), |b| {
             b.iter(|| rays.iter().filter(|r| mesh.occluded(r, t_max)).count())
+        });
+        g.bench_function(format!("any_{name}_prism_kd_exact_build"), |b| {
+            b.iter(|| rays.iter().filter(|r| exact.occluded(r, t_max)).count())
         });
         g.bench_function(format!("any_{name}_obvhs_own_test"), |b| {
             b.iter(|| {
