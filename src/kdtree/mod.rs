@@ -12,6 +12,14 @@
 //! [`KdPrimitives::clipped_bounds`] that are sorted and merged in, so no child is re-sorted
 //! and the whole build stays O(N log N).
 //!
+//! Nodes of more than [`KdParams::binned_above`] references take a cheaper path: each
+//! reference is its primitive's bounds clipped to the node; per axis their faces are counted
+//! into 32 bins and the planes between bins are priced, together with the two planes through
+//! the extreme faces (which cut empty space as exactly as the sweep). Nodes of a dozen
+//! references or fewer price every face of every box exactly. Straddlers are clipped to both
+//! children; children of large nodes are built with `rayon::join` and joined in a fixed order,
+//! so the tree does not depend on the thread count.
+//!
 //! **Layout** (as in pbrt). Nodes are 8 bytes in one depth-first array: an interior node holds
 //! the split position and, beside the axis in two low bits, the index of its above child; its
 //! below child is the next node. A leaf holds its primitive count and either its only primitive
