@@ -24,6 +24,12 @@ fn icosphere(k: u32) -> (Vec<Vec3>, Vec<[u32; 3]>) {
     (p, f)
 }
 
+/// Tree figures beside the timings: quality must not be bought away for build speed.
+fn report(name: &str, m: &TriangleMesh) {
+    let cost = m.tree().sah_cost(&TriangleMesh::kd_params());
+    eprintln!("mesh_build/{name}: SAH cost {cost:.2}; {}", m.stats().tree);
+}
+
 fn builds(c: &mut Criterion) {
     let mut g = c.benchmark_group("mesh_build");
     g.sample_size(10);
@@ -37,6 +43,7 @@ fn builds(c: &mut Criterion) {
     ] {
         let path = root.join(file);
         if path.is_file() {
+            report(name, &load_mesh(&path).unwrap());
             g.bench_function(name, |b| b.iter(|| load_mesh(&path).unwrap()));
         } else {
             eprintln!(
@@ -45,10 +52,70 @@ fn builds(c: &mut Criterion) {
             );
         }
     }
+    report(
+        "bunny_3674",
+        &load_mesh(&root.join("assets/bunny.obj")).unwrap(),
+    );
     let (p, f) = icosphere(8);
+    report(
+        "icosphere_1310720",
+        &TriangleMesh::new(p.clone(), f.clone(), None, None).unwrap(),
+    );
     g.bench_function("icosphere_1310720", |b| {
         b.iter(|| TriangleMesh::new(black_box(p.clone()), f.clone(), None, None).unwrap())
     });
+    g.finish();
+
+    // The tree alone (no parsing, normals or topology), on one thread and on two.
+    let mut meshes = vec![(
+        "bunny_3674",
+        load_mesh(&root.join("assets/bunny.obj")).unwrap(),
+    )];
+    for (name, file) in [
+        ("bunny_full_69666", "models/bunny.obj"),
+        ("dragon_871k", "models/dragon_vrip.ply"),
+    ] {
+        if root.join(file).is_file() {
+            meshes.push((name, load_mesh(&root.join(file)).unwrap()));
+        }
+    }
+    meshes.push((
+        "icosphere_1310720",
+        TriangleMesh::new(p, f, None, None).unwrap(),
+    ));
+    let mut g = c.benchmark_group("kd_build");
+    g.sample_size(10);
+    let params = TriangleMesh::kd_params();
+    // The exact event sweep everywhere (the builder before binning), on the meshes where it
+    // takes seconds rather than tens of seconds.
+    let exact = KdParams {
+        binned_above: usize::MAX,
+        ..params
+    };
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(1)
+        .build()
+        .unwrap();
+    for (name, m) in meshes.iter().filter(|(n, _)| n.starts_with("bunny")) {
+        eprintln!(
+            "kd_build/{name}: exact events everywhere: SAH cost {:.2}",
+            m.build_tree(&exact).sah_cost(&params)
+        );
+        g.bench_function(format!("{name}_exact_events_1t"), |b| {
+            b.iter(|| pool.install(|| m.build_tree(&exact)))
+        });
+    }
+    for threads in [1, 2] {
+        let pool = rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap();
+        for (name, m) in &meshes {
+            g.bench_function(format!("{name}_{threads}t"), |b| {
+                b.iter(|| pool.install(|| m.build_tree(&params)))
+            });
+        }
+    }
     g.finish();
 }
 
@@ -103,6 +170,153 @@ fn throughput(c: &mut Criterion) {
             b.iter(|| {
                 rays.iter()
                     .filter(|r| scene.occluded::<false>(r, 1e4, 0.0))
+                    .count()
+            })
+        });
+    }
+    g.finish();
+    versus_obvhs(c, &scene, &primary, &bounce);
+}
+
+/// The bunny alone, on the same rays carried into its object space: prism's kd-tree against
+/// obvhs's BVH2 (PLOC, `medium_build`), the latter once with its own Möller–Trumbore test and
+/// once with prism's watertight test.
+fn versus_obvhs(
+    c: &mut Criterion,
+    scene: &prism::systems::RenderScene,
+    primary: &[Ray],
+    bounce: &[Ray],
+) {
+    use obvhs::{
+        BvhBuildParams, bvh2::builder::build_bvh2_from_tris, ray::RayHit, triangle::Triangle,
+    };
+    use prism::geometry::mesh::RayFrame;
+    let placed = &scene.prims.meshes[0];
+    let mesh = &placed.shape;
+    let tri_of = |i: u32| mesh.triangle(i);
+    let tris: Vec<Triangle> = (0..mesh.triangle_count() as u32)
+        .map(|i| {
+            let [v0, v1, v2] = tri_of(i).map(Vec3::into);
+            Triangle { v0, v1, v2 }
+        })
+        .collect();
+    // The same mesh with the exact event sweep everywhere: the tree the builder made before
+    // binning, to compare trees on the same rays.
+    let exact = TriangleMesh::with_params(
+        mesh.positions().to_vec(),
+        mesh.indices().to_vec(),
+        Some(mesh.normals().to_vec()),
+        mesh.uvs().map(<[Vec2]>::to_vec),
+        &KdParams {
+            binned_above: usize::MAX,
+            ..TriangleMesh::kd_params()
+        },
+    )
+    .unwrap();
+    let bvh = build_bvh2_from_tris(
+        &tris,
+        BvhBuildParams::medium_build(),
+        &mut Default::default(),
+    );
+    // Triangles in leaf order, as obvhs recommends, so the hot loop needs no index indirection.
+    let ordered: Vec<Triangle> = bvh
+        .primitive_indices
+        .iter()
+        .map(|&i| tris[i as usize])
+        .collect();
+    let ordered_p: Vec<[Vec3; 3]> = bvh.primitive_indices.iter().map(|&i| tri_of(i)).collect();
+    let t_max = 1e4f32;
+    let obj = |rays: &[Ray]| -> Vec<Ray> { rays.iter().map(|r| placed.ray_to_object(r)).collect() };
+    let to_ob = |r: &Ray, t: f32| obvhs::ray::Ray::new(r.o.into(), r.d.into(), 0.0, t);
+
+    let mut g = c.benchmark_group("mesh_vs_obvhs");
+    for (name, rays) in [("primary", obj(primary)), ("diffuse", obj(bounce))] {
+        let n = rays.len();
+        // The two structures must agree before their speeds mean anything.
+        let hits = rays
+            .iter()
+            .filter(|r| mesh.intersect(r, f32::INFINITY).is_some())
+            .count();
+        let ob_hits = rays
+            .iter()
+            .filter(|r| {
+                let mut h = RayHit::none();
+                bvh.ray_traverse(to_ob(r, f32::INFINITY), &mut h, |ray, i| {
+                    ordered[i].intersect(ray)
+                })
+            })
+            .count();
+        eprintln!("mesh_vs_obvhs/{name}: {n} rays, prism {hits} hits, obvhs {ob_hits} hits");
+
+        g.bench_function(format!("closest_{name}_prism_kd"), |b| {
+            b.iter(|| {
+                rays.iter()
+                    .filter(|r| mesh.intersect(r, t_max).is_some())
+                    .count()
+            })
+        });
+        g.bench_function(format!("closest_{name}_prism_kd_exact_build"), |b| {
+            b.iter(|| {
+                rays.iter()
+                    .filter(|r| exact.intersect(r, t_max).is_some())
+                    .count()
+            })
+        });
+        g.bench_function(format!("closest_{name}_obvhs_own_test"), |b| {
+            b.iter(|| {
+                rays.iter()
+                    .filter(|r| {
+                        let mut h = RayHit::none();
+                        bvh.ray_traverse(to_ob(r, t_max), &mut h, |ray, i| {
+                            ordered[i].intersect(ray)
+                        })
+                    })
+                    .count()
+            })
+        });
+        g.bench_function(format!("closest_{name}_obvhs_watertight"), |b| {
+            b.iter(|| {
+                rays.iter()
+                    .filter(|r| {
+                        let Some(f) = RayFrame::new(r) else {
+                            return false;
+                        };
+                        let mut h = RayHit::none();
+                        bvh.ray_traverse(to_ob(r, t_max), &mut h, |ray, i| {
+                            f.hit(&ordered_p[i], ray.tmax)
+                                .map_or(f32::INFINITY, |x| x.0)
+                        })
+                    })
+                    .count()
+            })
+        });
+        g.bench_function(format!("any_{name}_prism_kd"), |b| {
+            b.iter(|| rays.iter().filter(|r| mesh.occluded(r, t_max)).count())
+        });
+        g.bench_function(format!("any_{name}_prism_kd_exact_build"), |b| {
+            b.iter(|| rays.iter().filter(|r| exact.occluded(r, t_max)).count())
+        });
+        g.bench_function(format!("any_{name}_obvhs_own_test"), |b| {
+            b.iter(|| {
+                rays.iter()
+                    .filter(|r| {
+                        !bvh.ray_traverse_miss(to_ob(r, t_max), |ray, i| ordered[i].intersect(ray))
+                    })
+                    .count()
+            })
+        });
+        g.bench_function(format!("any_{name}_obvhs_watertight"), |b| {
+            b.iter(|| {
+                rays.iter()
+                    .filter(|r| {
+                        let Some(f) = RayFrame::new(r) else {
+                            return false;
+                        };
+                        !bvh.ray_traverse_miss(to_ob(r, t_max), |ray, i| {
+                            f.hit(&ordered_p[i], ray.tmax)
+                                .map_or(f32::INFINITY, |x| x.0)
+                        })
+                    })
                     .count()
             })
         });

@@ -296,6 +296,62 @@ fn tree_matches_brute_force_on_curved_flat_and_boxy_meshes() {
 }
 
 #[test]
+fn binned_trees_match_brute_force() {
+    // Above the binning threshold with the mesh defaults, and with binning pushed down to
+    // small nodes: upper levels binned, straddlers clipped, lower levels exact.
+    let mut rng = Pcg64::seed_from_u64(12);
+    let sphere = perturb(icosphere(6), 0.02, 0.002, &mut rng);
+    assert!(sphere.1.len() > TriangleMesh::kd_params().binned_above);
+    let low = KdParams {
+        binned_above: 16,
+        ..TriangleMesh::kd_params()
+    };
+    let meshes = [
+        ("perturbed icosphere, default", build(sphere.clone())),
+        (
+            "perturbed icosphere, binned to 16",
+            TriangleMesh::with_params(sphere.0, sphere.1, None, None, &low).unwrap(),
+        ),
+        (
+            "grid, binned to 16",
+            TriangleMesh::with_params(grid(40).0, grid(40).1, None, None, &low).unwrap(),
+        ),
+        (
+            "cube, binned to 16",
+            TriangleMesh::with_params(cube(12).0, cube(12).1, None, None, &low).unwrap(),
+        ),
+    ];
+    for (k, (name, mesh)) in meshes.iter().enumerate() {
+        let tree = &mesh.stats().tree;
+        assert_eq!(tree.skipped, 0, "{name}");
+        assert!(tree.prim_refs >= mesh.triangle_count(), "{name}: {tree}");
+        let c = compare_mesh(mesh, 6_000, 300 + k as u64);
+        assert!(c.hits > 1000, "{name}: {} hits", c.hits);
+    }
+}
+
+#[test]
+fn mesh_tree_is_the_same_whatever_the_thread_count() {
+    let mut rng = Pcg64::seed_from_u64(13);
+    let mesh = build(perturb(icosphere(6), 0.02, 0.002, &mut rng));
+    let params = TriangleMesh::kd_params();
+    let on = |threads: usize| {
+        rayon::ThreadPoolBuilder::new()
+            .num_threads(threads)
+            .build()
+            .unwrap()
+            .install(|| mesh.build_tree(&params))
+    };
+    let (one, two) = (on(1), on(2));
+    assert_eq!(one.raw(), two.raw());
+    assert_eq!(one.raw(), mesh.tree().raw());
+    let (mut a, mut b) = (one.stats().clone(), two.stats().clone());
+    (a.build_seconds, b.build_seconds) = (0.0, 0.0);
+    assert_eq!(a, b);
+    assert_eq!(one.sah_cost(&params), two.sah_cost(&params));
+}
+
+#[test]
 fn perfect_splits_reference_fewer_triangles_than_box_splits() {
     // Long thin slivers in random directions: each triangle's box is far larger than the
     // triangle, so a tree over boxes duplicates references where clipped triangles do not.

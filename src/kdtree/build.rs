@@ -7,6 +7,7 @@
 
 use super::node::KdNode;
 use super::{KdParams, KdPrimitives, KdStats, MAX_DEPTH};
+
 use crate::geometry::Aabb;
 
 const AXIS_SHIFT: u32 = 62;
@@ -130,6 +131,13 @@ const BOTH: u8 = 0;
 const LEFT: u8 = 1;
 const RIGHT: u8 = 2;
 
+/// Bins per axis of the binned SAH.
+const BINS: usize = 32;
+
+/// Nodes with at least this many references build their two children in parallel. Fixed, so
+/// that the tree is the same whatever the thread count.
+const PARALLEL_ABOVE: usize = 4096;
+
 /// What `build` hands back to `KdTree`.
 pub(crate) struct Built {
     pub nodes: Vec<KdNode>,
@@ -138,20 +146,86 @@ pub(crate) struct Built {
     pub stats: KdStats,
 }
 
-struct Builder<'a, P: KdPrimitives + ?Sized> {
+/// A subtree in depth-first order, its above-child indices and leaf offsets relative to its
+/// own arrays; appending it to another shifts them.
+#[derive(Default)]
+struct Frag {
+    nodes: Vec<KdNode>,
+    indices: Vec<u32>,
+    leaves: usize,
+    empty_leaves: usize,
+    depth: u32,
+    prim_refs: usize,
+}
+
+impl Frag {
+    fn append(&mut self, other: Frag) {
+        let (dn, di) = (self.nodes.len() as u32, self.indices.len() as u32);
+        self.nodes
+            .extend(other.nodes.into_iter().map(|n| n.shifted(dn, di)));
+        self.indices.extend_from_slice(&other.indices);
+        self.leaves += other.leaves;
+        self.empty_leaves += other.empty_leaves;
+        self.depth = self.depth.max(other.depth);
+        self.prim_refs += other.prim_refs;
+    }
+
+    fn leaf(&mut self, prims: &mut [u32], depth: u32) {
+        // Sorted, so a leaf's order does not depend on how the build reached it.
+        prims.sort_unstable();
+        let count = prims.len() as u32;
+        let node = match prims.len() {
+            0 => KdNode::leaf(0, 0),
+            1 => KdNode::leaf(1, prims[0]),
+            _ => {
+                let offset = u32::try_from(self.indices.len()).expect("kd-tree index count");
+                self.indices.extend_from_slice(prims);
+                KdNode::leaf(count, offset)
+            }
+        };
+        self.nodes.push(node);
+        self.leaves += 1;
+        self.empty_leaves += usize::from(count == 0);
+        self.prim_refs += prims.len();
+        self.depth = self.depth.max(depth);
+    }
+}
+
+/// Reference buffers of finished nodes, reused by later ones: one depth-first task allocates
+/// about two per level instead of two per node.
+#[derive(Default)]
+struct Pool(Vec<Vec<Ref>>);
+
+impl Pool {
+    fn take(&mut self) -> Vec<Ref> {
+        self.0.pop().unwrap_or_default()
+    }
+
+    fn put(&mut self, mut v: Vec<Ref>) {
+        v.clear();
+        self.0.push(v);
+    }
+}
+
+/// Nodes of at most this many references have every box face priced exactly.
+const FEW: usize = 12;
+
+/// A primitive's part inside a node: its index and the bounds of that part.
+#[derive(Clone, Copy)]
+struct Ref {
+    b: Aabb,
+    prim: u32,
+}
+
+/// The cost model and limits, shared by every task of a build.
+struct Ctx<'a, P: KdPrimitives + ?Sized> {
     prims: &'a P,
     traversal_cost: f32,
     intersect_cost: f32,
     empty_bonus: f32,
     max_leaf_prims: u32,
     max_depth: u32,
-    side: Vec<u8>,
-    nodes: Vec<KdNode>,
-    indices: Vec<u32>,
-    leaves: usize,
-    empty_leaves: usize,
-    depth_reached: u32,
-    prim_refs: usize,
+    binned_above: usize,
 }
 
 pub(crate) fn build<P: KdPrimitives + ?Sized>(prims: &P, params: &KdParams) -> Built {
@@ -163,73 +237,369 @@ pub(crate) fn build<P: KdPrimitives + ?Sized>(prims: &P, params: &KdParams) -> B
 
     // Boxes that are empty or not finite cannot take part in plane sweeps; they are left out.
     let mut bounds = Aabb::EMPTY;
-    let mut events = Vec::with_capacity(6 * n);
-    let mut kept = 0usize;
+    let mut refs = Vec::with_capacity(n);
     for i in 0..n as u32 {
         let b = prims.bounds(i);
         if b.is_empty() || !b.min.is_finite() || !b.max.is_finite() {
             continue;
         }
-        kept += 1;
         bounds = bounds.union(&b);
-        push_events(&mut events, i, &b);
+        refs.push(Ref { b, prim: i });
     }
-    events.sort_unstable();
+    let kept = refs.len();
 
-    let mut builder = Builder {
+    let ctx = Ctx {
         prims,
         traversal_cost: params.traversal_cost,
         intersect_cost: params.intersect_cost,
         empty_bonus: params.empty_bonus,
         max_leaf_prims: params.max_leaf_prims,
         max_depth: params.depth_limit(kept),
-        side: vec![BOTH; n],
-        nodes: Vec::new(),
-        indices: Vec::new(),
-        leaves: 0,
-        empty_leaves: 0,
-        depth_reached: 0,
-        prim_refs: 0,
+        binned_above: params.binned_above,
     };
+    let mut frag = Frag::default();
     if kept > 0 {
-        builder.node(events, bounds, 0);
+        ctx.binned(refs, bounds, 0, &mut frag, &mut Pool::default());
     }
 
-    let non_empty = builder.leaves - builder.empty_leaves;
+    let non_empty = frag.leaves - frag.empty_leaves;
     let stats = KdStats {
         primitives: n,
         skipped: n - kept,
-        nodes: builder.nodes.len(),
-        leaves: builder.leaves,
-        empty_leaves: builder.empty_leaves,
-        max_depth: builder.depth_reached,
+        nodes: frag.nodes.len(),
+        leaves: frag.leaves,
+        empty_leaves: frag.empty_leaves,
+        max_depth: frag.depth,
         mean_leaf_prims: if non_empty > 0 {
-            builder.prim_refs as f32 / non_empty as f32
+            frag.prim_refs as f32 / non_empty as f32
         } else {
             0.0
         },
-        prim_refs: builder.prim_refs,
+        prim_refs: frag.prim_refs,
         build_seconds: 0.0,
     };
     Built {
-        nodes: builder.nodes,
-        indices: builder.indices,
+        nodes: frag.nodes,
+        indices: frag.indices,
         bounds,
         stats,
     }
 }
 
-impl<P: KdPrimitives + ?Sized> Builder<'_, P> {
+impl<P: KdPrimitives + ?Sized> Ctx<'_, P> {
+    /// SAH cost of a split; an empty side earns the bonus only if it has volume, since cutting
+    /// off a flat empty slab saves nothing.
+    #[inline]
+    fn cost(&self, pl: f32, pr: f32, nl: u32, nr: u32, wl: f32, wr: f32) -> f32 {
+        let empty = (nl == 0 && wl > 0.0) || (nr == 0 && wr > 0.0);
+        let scale = if empty { 1.0 - self.empty_bonus } else { 1.0 };
+        self.traversal_cost + self.intersect_cost * scale * (pl * nl as f32 + pr * nr as f32)
+    }
+
+    /// The parts of the primitives straddling a plane, clipped to each side (perfect splits).
+    fn clip_both(&self, p: u32, split: &Split, below: &Aabb, above: &Aabb) -> (Aabb, Aabb) {
+        let cell = below.union(above);
+        let (bl, br) = self.prims.split_bounds(p, &cell, split.axis, split.pos);
+        let (bl, br) = (bl.intersection(below), br.intersection(above));
+        if bl.is_empty() && br.is_empty() {
+            // A clip that finds the primitive on neither side is numerical trouble: fall
+            // back to plain boxes rather than lose it.
+            let b = self.prims.bounds(p);
+            return (b.intersection(below), b.intersection(above));
+        }
+        (bl, br)
+    }
+
+    /// A node of the binned levels: the split comes from binned counts (or, for a handful of
+    /// references, from every face of every box), the children are built in parallel when
+    /// large; nodes of at most `binned_above` references go to the exact event sweep.
+    fn binned(&self, refs: Vec<Ref>, cell: Aabb, depth: u32, out: &mut Frag, pool: &mut Pool) {
+        let n = refs.len();
+        if n <= self.binned_above {
+            self.exact(&refs, cell, depth, out);
+            pool.put(refs);
+            return;
+        }
+        let split = if n as u32 <= self.max_leaf_prims || depth >= self.max_depth {
+            None
+        } else if n <= FEW {
+            self.few_split(&refs, &cell, n as u32)
+        } else {
+            self.binned_split(&refs, &cell, n as u32)
+        };
+        let Some(split) = split.filter(|s| s.cost < self.intersect_cost * n as f32) else {
+            let mut prims: Vec<u32> = refs.iter().map(|r| r.prim).collect();
+            out.leaf(&mut prims, depth);
+            pool.put(refs);
+            return;
+        };
+        let mut below = cell;
+        below.max[split.axis] = split.pos;
+        let mut above = cell;
+        above.min[split.axis] = split.pos;
+        let (left, right) = self.partition_refs(&refs, &split, &below, &above, pool);
+        if left.len() == n && right.len() == n {
+            // No reference settled on one side (rounding in a degenerate cell): the exact
+            // sweep decides, and always terminates.
+            self.exact(&refs, cell, depth, out);
+            pool.put(refs);
+            pool.put(left);
+            pool.put(right);
+            return;
+        }
+        pool.put(refs);
+
+        let me = out.nodes.len();
+        out.nodes.push(KdNode::leaf(0, 0)); // patched once the above child's index is known
+        if n >= PARALLEL_ABOVE {
+            let (l, r) = rayon::join(
+                || {
+                    let mut f = Frag::default();
+                    self.binned(left, below, depth + 1, &mut f, &mut Pool::default());
+                    f
+                },
+                || {
+                    let mut f = Frag::default();
+                    self.binned(right, above, depth + 1, &mut f, &mut Pool::default());
+                    f
+                },
+            );
+            out.append(l);
+            let above_index = u32::try_from(out.nodes.len()).expect("kd-tree node count");
+            out.nodes[me] = KdNode::interior(split.axis, split.pos, above_index);
+            out.append(r);
+        } else {
+            self.binned(left, below, depth + 1, out, pool);
+            let above_index = u32::try_from(out.nodes.len()).expect("kd-tree node count");
+            out.nodes[me] = KdNode::interior(split.axis, split.pos, above_index);
+            self.binned(right, above, depth + 1, out, pool);
+        }
+    }
+
+    /// Exact SAH for a handful of references: every face of every box is a candidate, its
+    /// counts taken by looking at every reference (what the event sweep finds, without
+    /// sorting or allocating).
+    fn few_split(&self, refs: &[Ref], cell: &Aabb, n: u32) -> Option<Split> {
+        let sa = cell.surface_area();
+        if sa <= 0.0 {
+            return None;
+        }
+        let inv_sa = 1.0 / sa;
+        let d = cell.diagonal();
+        let mut best: Option<Split> = None;
+        let mut best_cost = f32::INFINITY;
+        for axis in 0..3 {
+            let (lo, hi) = (cell.min[axis], cell.max[axis]);
+            if hi <= lo {
+                continue;
+            }
+            let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+            let cap = d[u] * d[v];
+            let rim = d[u] + d[v];
+            for c in refs {
+                for pos in [c.b.min[axis], c.b.max[axis]] {
+                    if pos < lo || pos > hi {
+                        continue;
+                    }
+                    let (mut l, mut r, mut planar) = (0u32, 0u32, 0u32);
+                    for x in refs {
+                        let (a, b) = (x.b.min[axis], x.b.max[axis]);
+                        if a == pos && b == pos {
+                            planar += 1;
+                        } else {
+                            l += u32::from(a < pos);
+                            r += u32::from(b > pos);
+                        }
+                    }
+                    debug_assert!(l + r + planar >= n);
+                    let (wl, wr) = (pos - lo, hi - pos);
+                    let pl = 2.0 * (cap + wl * rim) * inv_sa;
+                    let pr = 2.0 * (cap + wr * rim) * inv_sa;
+                    let mut consider = |l: u32, r: u32, planar_left: bool| {
+                        if (wl == 0.0 && l == 0) || (wr == 0.0 && r == 0) {
+                            return;
+                        }
+                        let c = self.cost(pl, pr, l, r, wl, wr);
+                        if c < best_cost {
+                            best_cost = c;
+                            best = Some(Split {
+                                axis,
+                                pos,
+                                planar_left,
+                                cost: c,
+                            });
+                        }
+                    };
+                    consider(l + planar, r, true);
+                    if planar > 0 {
+                        consider(l, r + planar, false);
+                    }
+                }
+            }
+        }
+        best
+    }
+
+    /// Binned SAH: per axis, the references' box faces counted into equal bins; the planes
+    /// between bins are priced from the running counts (a reference whose box ends in a bin
+    /// before the plane is left of it, one starting in a bin before it reaches left).
+    fn binned_split(&self, refs: &[Ref], cell: &Aabb, n: u32) -> Option<Split> {
+        let sa = cell.surface_area();
+        if sa <= 0.0 {
+            return None;
+        }
+        let inv_sa = 1.0 / sa;
+        let d = cell.diagonal();
+        let mut best: Option<Split> = None;
+        let mut best_cost = f32::INFINITY;
+        for axis in 0..3 {
+            let (lo, hi) = (cell.min[axis], cell.max[axis]);
+            if hi <= lo {
+                continue;
+            }
+            let scale = BINS as f32 / (hi - lo);
+            let bin = |x: f32| (((x - lo) * scale) as usize).min(BINS - 1);
+            let mut starts = [0u32; BINS];
+            let mut ends = [0u32; BINS];
+            let (mut first, mut last) = (f32::INFINITY, f32::NEG_INFINITY);
+            for r in refs {
+                starts[bin(r.b.min[axis])] += 1;
+                ends[bin(r.b.max[axis])] += 1;
+                first = first.min(r.b.min[axis]);
+                last = last.max(r.b.max[axis]);
+            }
+            let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+            let cap = d[u] * d[v];
+            let rim = d[u] + d[v];
+            // Bins cut empty space only to their width; the planes through the references'
+            // extreme faces cut it exactly, with all references on one side (flat ones in
+            // the plane go with them).
+            for (pos, planar_left) in [(first, false), (last, true)] {
+                if pos <= lo || pos >= hi {
+                    continue;
+                }
+                let (wl, wr) = (pos - lo, hi - pos);
+                let pl = 2.0 * (cap + wl * rim) * inv_sa;
+                let pr = 2.0 * (cap + wr * rim) * inv_sa;
+                let (l, r) = if planar_left { (n, 0) } else { (0, n) };
+                let c = self.cost(pl, pr, l, r, wl, wr);
+                if c < best_cost {
+                    best_cost = c;
+                    best = Some(Split {
+                        axis,
+                        pos,
+                        planar_left,
+                        cost: c,
+                    });
+                }
+            }
+            let (mut nl, mut nr) = (0u32, n);
+            for k in 1..BINS {
+                nl += starts[k - 1];
+                nr -= ends[k - 1];
+                let pos = lo + (hi - lo) * (k as f32 / BINS as f32);
+                if pos <= lo || pos >= hi {
+                    continue;
+                }
+                let (wl, wr) = (pos - lo, hi - pos);
+                let pl = 2.0 * (cap + wl * rim) * inv_sa;
+                let pr = 2.0 * (cap + wr * rim) * inv_sa;
+                let c = self.cost(pl, pr, nl, nr, wl, wr);
+                if c < best_cost {
+                    best_cost = c;
+                    best = Some(Split {
+                        axis,
+                        pos,
+                        planar_left: true,
+                        cost: c,
+                    });
+                }
+            }
+        }
+        best
+    }
+
+    /// References wholly on one side keep their bounds; straddlers are clipped to each side.
+    fn partition_refs(
+        &self,
+        refs: &[Ref],
+        split: &Split,
+        below: &Aabb,
+        above: &Aabb,
+        pool: &mut Pool,
+    ) -> (Vec<Ref>, Vec<Ref>) {
+        let (a, pos) = (split.axis, split.pos);
+        let mut left = pool.take();
+        let mut right = pool.take();
+        for r in refs {
+            let (lo, hi) = (r.b.min[a], r.b.max[a]);
+            if hi <= pos && (lo < pos || split.planar_left) {
+                left.push(*r);
+            } else if lo >= pos {
+                right.push(*r);
+            } else {
+                let (bl, br) = self.clip_both(r.prim, split, below, above);
+                if !bl.is_empty() {
+                    left.push(Ref {
+                        b: bl,
+                        prim: r.prim,
+                    });
+                }
+                if !br.is_empty() {
+                    right.push(Ref {
+                        b: br,
+                        prim: r.prim,
+                    });
+                }
+            }
+        }
+        (left, right)
+    }
+
+    /// The exact sweep over sorted events (Wald & Havran) for the subtree of these references,
+    /// with primitives renumbered locally so that its scratch is sized by the subtree.
+    fn exact(&self, refs: &[Ref], cell: Aabb, depth: u32, out: &mut Frag) {
+        let mut events = Vec::with_capacity(6 * refs.len());
+        for (k, r) in refs.iter().enumerate() {
+            push_events(&mut events, k as u32, &r.b);
+        }
+        events.sort_unstable();
+        let mut b = Exact {
+            ctx: self,
+            ids: refs.iter().map(|r| r.prim).collect(),
+            side: vec![BOTH; refs.len()],
+            scratch: Vec::new(),
+            out,
+        };
+        b.node(events, cell, depth);
+    }
+}
+
+/// State of one exact subtree build: local primitive k is `ids[k]`.
+struct Exact<'a, 'c, P: KdPrimitives + ?Sized> {
+    ctx: &'a Ctx<'c, P>,
+    ids: Vec<u32>,
+    side: Vec<u8>,
+    scratch: Vec<u32>,
+    out: &'a mut Frag,
+}
+
+impl<P: KdPrimitives + ?Sized> Exact<'_, '_, P> {
     fn node(&mut self, events: Vec<u64>, cell: Aabb, depth: u32) {
         let n = node_prims(&events).count() as u32;
-        let split = if n <= self.max_leaf_prims || depth >= self.max_depth {
+        let split = if n <= self.ctx.max_leaf_prims || depth >= self.ctx.max_depth {
             None
         } else {
             self.find_split(&events, &cell, n)
-                .filter(|s| s.cost < self.intersect_cost * n as f32)
+                .filter(|s| s.cost < self.ctx.intersect_cost * n as f32)
         };
         let Some(split) = split else {
-            self.leaf(&events, depth);
+            self.scratch.clear();
+            self.scratch
+                .extend(node_prims(&events).map(|k| self.ids[k as usize]));
+            let mut prims = std::mem::take(&mut self.scratch);
+            self.out.leaf(&mut prims, depth);
+            self.scratch = prims;
             return;
         };
 
@@ -240,41 +610,12 @@ impl<P: KdPrimitives + ?Sized> Builder<'_, P> {
         let (left, right) = self.partition(&events, &split, &below, &above);
         drop(events);
 
-        let me = self.nodes.len();
-        self.nodes.push(KdNode::leaf(0, 0)); // patched once the above child's index is known
+        let me = self.out.nodes.len();
+        self.out.nodes.push(KdNode::leaf(0, 0)); // patched once the above child's index is known
         self.node(left, below, depth + 1);
-        let above_index = u32::try_from(self.nodes.len()).expect("kd-tree node count");
-        self.nodes[me] = KdNode::interior(split.axis, split.pos, above_index);
+        let above_index = u32::try_from(self.out.nodes.len()).expect("kd-tree node count");
+        self.out.nodes[me] = KdNode::interior(split.axis, split.pos, above_index);
         self.node(right, above, depth + 1);
-    }
-
-    fn leaf(&mut self, events: &[u64], depth: u32) {
-        let mut prims: Vec<u32> = node_prims(events).collect();
-        prims.sort_unstable();
-        let count = prims.len() as u32;
-        let node = match prims.len() {
-            0 => KdNode::leaf(0, 0),
-            1 => KdNode::leaf(1, prims[0]),
-            _ => {
-                let offset = u32::try_from(self.indices.len()).expect("kd-tree index count");
-                self.indices.extend_from_slice(&prims);
-                KdNode::leaf(count, offset)
-            }
-        };
-        self.nodes.push(node);
-        self.leaves += 1;
-        self.empty_leaves += usize::from(count == 0);
-        self.prim_refs += prims.len();
-        self.depth_reached = self.depth_reached.max(depth);
-    }
-
-    /// SAH cost of a split; an empty side earns the bonus only if it has volume, since cutting
-    /// off a flat empty slab saves nothing.
-    #[inline]
-    fn cost(&self, pl: f32, pr: f32, nl: u32, nr: u32, wl: f32, wr: f32) -> f32 {
-        let empty = (nl == 0 && wl > 0.0) || (nr == 0 && wr > 0.0);
-        let scale = if empty { 1.0 - self.empty_bonus } else { 1.0 };
-        self.traversal_cost + self.intersect_cost * scale * (pl * nl as f32 + pr * nr as f32)
     }
 
     /// One sweep over the sorted events: at each candidate plane the counts of primitives
@@ -325,7 +666,7 @@ impl<P: KdPrimitives + ?Sized> Builder<'_, P> {
                     if (wl == 0.0 && l == 0) || (wr == 0.0 && r == 0) {
                         return;
                     }
-                    let c = self.cost(pl, pr, l, r, wl, wr);
+                    let c = self.ctx.cost(pl, pr, l, r, wl, wr);
                     if c < best_cost {
                         best_cost = c;
                         best = Some(Split {
@@ -397,24 +738,18 @@ impl<P: KdPrimitives + ?Sized> Builder<'_, P> {
 
         let mut new_left = Vec::new();
         let mut new_right = Vec::new();
-        for p in node_prims(events) {
-            if self.side[p as usize] != BOTH {
+        for k in node_prims(events) {
+            if self.side[k as usize] != BOTH {
                 continue;
             }
-            let mut bl = self.prims.clipped_bounds(p, below).intersection(below);
-            let mut br = self.prims.clipped_bounds(p, above).intersection(above);
-            if bl.is_empty() && br.is_empty() {
-                // A clip that finds the primitive on neither side is numerical trouble: fall
-                // back to plain boxes rather than lose it.
-                let b = self.prims.bounds(p);
-                bl = b.intersection(below);
-                br = b.intersection(above);
-            }
+            let (bl, br) = self
+                .ctx
+                .clip_both(self.ids[k as usize], split, below, above);
             if !bl.is_empty() {
-                push_events(&mut new_left, p, &bl);
+                push_events(&mut new_left, k, &bl);
             }
             if !br.is_empty() {
-                push_events(&mut new_right, p, &br);
+                push_events(&mut new_right, k, &br);
             }
         }
         new_left.sort_unstable();
@@ -550,6 +885,67 @@ mod tests {
         );
         assert!(s.max_depth <= KdParams::default().depth_limit(2000));
         assert!(s.build_seconds >= 0.0);
+    }
+
+    #[test]
+    fn binned_builds_cover_every_primitive() {
+        let boxes = random_boxes(20_000, 0.3, 17);
+        for binned_above in [8, 64, 4096] {
+            let params = KdParams {
+                binned_above,
+                ..KdParams::default()
+            };
+            let tree = KdTree::build(&boxes, &params);
+            check_structure(&tree, &boxes);
+            assert!(tree.stats().max_depth <= params.depth_limit(boxes.len()));
+        }
+        // Clipped straddlers in the binned levels.
+        let mut r = Rng(78);
+        let segs = Segments(
+            (0..6000)
+                .map(|_| {
+                    let a = r.v() * 10.0;
+                    (a, a + (r.v() - 0.5) * 3.0)
+                })
+                .collect(),
+        );
+        let tree = KdTree::build(
+            &segs,
+            &KdParams {
+                binned_above: 32,
+                ..KdParams::default()
+            },
+        );
+        for (i, &(a, b)) in segs.0.iter().enumerate() {
+            for k in 0..=8 {
+                check_covered(&tree, i as u32, a.lerp(b, k as f32 / 8.0));
+            }
+        }
+    }
+
+    #[test]
+    fn tree_is_the_same_on_one_and_two_threads() {
+        let boxes = random_boxes(40_000, 0.2, 23);
+        let params = KdParams {
+            binned_above: 256,
+            ..KdParams::default()
+        };
+        let on = |threads: usize| {
+            rayon::ThreadPoolBuilder::new()
+                .num_threads(threads)
+                .build()
+                .unwrap()
+                .install(|| KdTree::build(&boxes, &params))
+        };
+        let (one, two) = (on(1), on(2));
+        assert!(one.stats().nodes > 10_000);
+        assert_eq!(one.raw(), two.raw());
+        assert_eq!(one.bounds(), two.bounds());
+        let strip = |t: &KdTree| KdStats {
+            build_seconds: 0.0,
+            ..t.stats().clone()
+        };
+        assert_eq!(strip(&one), strip(&two));
     }
 
     #[test]

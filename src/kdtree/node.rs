@@ -67,6 +67,25 @@ impl KdNode {
         self.flags >> 2
     }
 
+    /// This node moved `nodes` places on in the node array, with its leaf runs moved `indices`
+    /// places on in the index array.
+    #[inline]
+    pub fn shifted(self, nodes: u32, indices: u32) -> Self {
+        if self.is_leaf() {
+            if self.prim_count() > 1 {
+                return Self::leaf(self.prim_count(), self.payload + indices);
+            }
+            self
+        } else {
+            Self::interior(self.axis(), self.split(), self.above() + nodes)
+        }
+    }
+
+    /// Payload and flags, for exact comparisons of trees.
+    pub fn words(&self) -> [u32; 2] {
+        [self.payload, self.flags]
+    }
+
     /// The inline primitive (count 1) or the run offset (count > 1), by reference so that a
     /// one-primitive leaf can be handed out as a one-element slice.
     #[inline]
