@@ -932,6 +932,7 @@ fn clip_to_cell(
     let mut n = 3;
     for axis in 0..3 {
         for (bound, keep_above) in [(cell.min[axis], true), (cell.max[axis], false)] {
+            // Planes the triangle lies wholly inside of need no clip (nor its rounding).
             let inside = if keep_above {
                 full.min[axis] >= bound
             } else {
@@ -969,38 +970,18 @@ fn clip_triangle(tri: &[Vec3; 3], node: &Aabb) -> Aabb {
     }
 
     let mut poly = [DVec3::ZERO; CLIP_CAP];
-    let mut scratch = [DVec3::ZERO; CLIP_CAP];
-    for (k, p) in tri.iter().enumerate() {
-        poly[k] = p.as_dvec3();
-    }
-    let mut n = 3;
-    for axis in 0..3 {
-        for (bound, keep_above) in [(cell.min[axis], true), (cell.max[axis], false)] {
-            // Planes the triangle lies wholly inside of need no clip (nor its rounding).
-            let inside = if keep_above {
-                full.min[axis] >= bound
-            } else {
-                full.max[axis] <= bound
-            };
-            if inside {
-                continue;
+    match clip_to_cell(tri, &full, &cell, &mut poly) {
+        Some(n) => {
+            let mut b = Aabb::EMPTY;
+            for p in &poly[..n] {
+                b = b.union_point(p.as_vec3());
             }
-            match clip_polygon(&poly[..n], &mut scratch, axis, f64::from(bound), keep_above) {
-                Some(0) => return Aabb::EMPTY,
-                Some(m) => {
-                    n = m;
-                    std::mem::swap(&mut poly, &mut scratch);
-                }
-                // Rounding made the polygon too complex: the plain box is still conservative.
-                None => return grow(full.intersection(&cell)),
-            }
+            // Nothing left inside: an empty box, not a padded point.
+            if n == 0 { b } else { grow(b) }
         }
+        // Rounding made the polygon too complex: the plain box is still conservative.
+        None => grow(full.intersection(&cell)),
     }
-    let mut b = Aabb::EMPTY;
-    for p in &poly[..n] {
-        b = b.union_point(p.as_vec3());
-    }
-    grow(b)
 }
 
 /// One Sutherland–Hodgman step: the part of the polygon on the kept side of the plane

@@ -118,6 +118,64 @@ fn merge(a: Vec<u64>, b: &[u64]) -> Vec<u64> {
     out
 }
 
+/// One axis of a cell, for pricing planes across it: a side of width w has surface area
+/// 2 (cap + w · rim), and its hit probability is that over the cell's.
+#[derive(Clone, Copy)]
+struct AxisCell {
+    lo: f32,
+    hi: f32,
+    cap: f32,
+    rim: f32,
+    inv_sa: f32,
+}
+
+impl AxisCell {
+    fn new(cell: &Aabb, axis: usize, inv_sa: f32) -> Self {
+        let d = cell.diagonal();
+        let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
+        Self {
+            lo: cell.min[axis],
+            hi: cell.max[axis],
+            cap: d[u] * d[v],
+            rim: d[u] + d[v],
+            inv_sa,
+        }
+    }
+
+    /// Widths and hit probabilities of the sides below and above `pos`.
+    #[inline]
+    fn sides(&self, pos: f32) -> (f32, f32, f32, f32) {
+        let (wl, wr) = (pos - self.lo, self.hi - pos);
+        let pl = 2.0 * (self.cap + wl * self.rim) * self.inv_sa;
+        let pr = 2.0 * (self.cap + wr * self.rim) * self.inv_sa;
+        (wl, wr, pl, pr)
+    }
+}
+
+/// The cheapest split offered so far; of equal costs the first offered stays, so the order
+/// of the offers (and nothing else) decides ties.
+struct Cheapest(Option<Split>);
+
+impl Cheapest {
+    #[inline]
+    fn offer(&mut self, axis: usize, pos: f32, planar_left: bool, cost: f32) {
+        if cost < self.0.map_or(f32::INFINITY, |b| b.cost) {
+            self.0 = Some(Split {
+                axis,
+                pos,
+                planar_left,
+                cost,
+            });
+        }
+    }
+}
+
+/// A flat side holding nothing leaves the other side the whole node: no split.
+#[inline]
+fn useless(wl: f32, wr: f32, l: u32, r: u32) -> bool {
+    (wl == 0.0 && l == 0) || (wr == 0.0 && r == 0)
+}
+
 #[derive(Clone, Copy, Debug)]
 struct Split {
     axis: usize,
@@ -384,21 +442,15 @@ impl<P: KdPrimitives + ?Sized> Ctx<'_, P> {
         if sa <= 0.0 {
             return None;
         }
-        let inv_sa = 1.0 / sa;
-        let d = cell.diagonal();
-        let mut best: Option<Split> = None;
-        let mut best_cost = f32::INFINITY;
+        let mut best = Cheapest(None);
         for axis in 0..3 {
-            let (lo, hi) = (cell.min[axis], cell.max[axis]);
-            if hi <= lo {
+            let ac = AxisCell::new(cell, axis, 1.0 / sa);
+            if ac.hi <= ac.lo {
                 continue;
             }
-            let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
-            let cap = d[u] * d[v];
-            let rim = d[u] + d[v];
             for c in refs {
                 for pos in [c.b.min[axis], c.b.max[axis]] {
-                    if pos < lo || pos > hi {
+                    if pos < ac.lo || pos > ac.hi {
                         continue;
                     }
                     let (mut l, mut r, mut planar) = (0u32, 0u32, 0u32);
@@ -412,22 +464,10 @@ impl<P: KdPrimitives + ?Sized> Ctx<'_, P> {
                         }
                     }
                     debug_assert!(l + r + planar >= n);
-                    let (wl, wr) = (pos - lo, hi - pos);
-                    let pl = 2.0 * (cap + wl * rim) * inv_sa;
-                    let pr = 2.0 * (cap + wr * rim) * inv_sa;
+                    let (wl, wr, pl, pr) = ac.sides(pos);
                     let mut consider = |l: u32, r: u32, planar_left: bool| {
-                        if (wl == 0.0 && l == 0) || (wr == 0.0 && r == 0) {
-                            return;
-                        }
-                        let c = self.cost(pl, pr, l, r, wl, wr);
-                        if c < best_cost {
-                            best_cost = c;
-                            best = Some(Split {
-                                axis,
-                                pos,
-                                planar_left,
-                                cost: c,
-                            });
+                        if !useless(wl, wr, l, r) {
+                            best.offer(axis, pos, planar_left, self.cost(pl, pr, l, r, wl, wr));
                         }
                     };
                     consider(l + planar, r, true);
@@ -437,7 +477,7 @@ impl<P: KdPrimitives + ?Sized> Ctx<'_, P> {
                 }
             }
         }
-        best
+        best.0
     }
 
     /// Binned SAH: per axis, the references' box faces counted into equal bins; the planes
@@ -448,12 +488,10 @@ impl<P: KdPrimitives + ?Sized> Ctx<'_, P> {
         if sa <= 0.0 {
             return None;
         }
-        let inv_sa = 1.0 / sa;
-        let d = cell.diagonal();
-        let mut best: Option<Split> = None;
-        let mut best_cost = f32::INFINITY;
+        let mut best = Cheapest(None);
         for axis in 0..3 {
-            let (lo, hi) = (cell.min[axis], cell.max[axis]);
+            let ac = AxisCell::new(cell, axis, 1.0 / sa);
+            let (lo, hi) = (ac.lo, ac.hi);
             if hi <= lo {
                 continue;
             }
@@ -468,9 +506,6 @@ impl<P: KdPrimitives + ?Sized> Ctx<'_, P> {
                 first = first.min(r.b.min[axis]);
                 last = last.max(r.b.max[axis]);
             }
-            let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
-            let cap = d[u] * d[v];
-            let rim = d[u] + d[v];
             // Bins cut empty space only to their width; the planes through the references'
             // extreme faces cut it exactly, with all references on one side (flat ones in
             // the plane go with them).
@@ -478,20 +513,9 @@ impl<P: KdPrimitives + ?Sized> Ctx<'_, P> {
                 if pos <= lo || pos >= hi {
                     continue;
                 }
-                let (wl, wr) = (pos - lo, hi - pos);
-                let pl = 2.0 * (cap + wl * rim) * inv_sa;
-                let pr = 2.0 * (cap + wr * rim) * inv_sa;
+                let (wl, wr, pl, pr) = ac.sides(pos);
                 let (l, r) = if planar_left { (n, 0) } else { (0, n) };
-                let c = self.cost(pl, pr, l, r, wl, wr);
-                if c < best_cost {
-                    best_cost = c;
-                    best = Some(Split {
-                        axis,
-                        pos,
-                        planar_left,
-                        cost: c,
-                    });
-                }
+                best.offer(axis, pos, planar_left, self.cost(pl, pr, l, r, wl, wr));
             }
             let (mut nl, mut nr) = (0u32, n);
             for k in 1..BINS {
@@ -501,22 +525,11 @@ impl<P: KdPrimitives + ?Sized> Ctx<'_, P> {
                 if pos <= lo || pos >= hi {
                     continue;
                 }
-                let (wl, wr) = (pos - lo, hi - pos);
-                let pl = 2.0 * (cap + wl * rim) * inv_sa;
-                let pr = 2.0 * (cap + wr * rim) * inv_sa;
-                let c = self.cost(pl, pr, nl, nr, wl, wr);
-                if c < best_cost {
-                    best_cost = c;
-                    best = Some(Split {
-                        axis,
-                        pos,
-                        planar_left: true,
-                        cost: c,
-                    });
-                }
+                let (wl, wr, pl, pr) = ac.sides(pos);
+                best.offer(axis, pos, true, self.cost(pl, pr, nl, nr, wl, wr));
             }
         }
-        best
+        best.0
     }
 
     /// References wholly on one side keep their bounds; straddlers are clipped to each side.
@@ -626,10 +639,7 @@ impl<P: KdPrimitives + ?Sized> Exact<'_, '_, P> {
         if sa <= 0.0 {
             return None;
         }
-        let inv_sa = 1.0 / sa;
-        let d = cell.diagonal();
-        let mut best: Option<Split> = None;
-        let mut best_cost = f32::INFINITY;
+        let mut best = Cheapest(None);
 
         let mut i = 0;
         while i < events.len() {
@@ -638,11 +648,7 @@ impl<P: KdPrimitives + ?Sized> Exact<'_, '_, P> {
             let run = &events[i..i + run];
             i += run.len();
 
-            let (u, v) = ((axis + 1) % 3, (axis + 2) % 3);
-            // Side areas are 2 (cap + w * rim) for a side of width w along the axis.
-            let cap = d[u] * d[v];
-            let rim = d[u] + d[v];
-            let (lo, hi) = (cell.min[axis], cell.max[axis]);
+            let ac = AxisCell::new(cell, axis, 1.0 / sa);
             let (mut nl, mut nr) = (0u32, n);
             let mut j = 0;
             while j < run.len() {
@@ -658,23 +664,10 @@ impl<P: KdPrimitives + ?Sized> Exact<'_, '_, P> {
                 }
                 nr -= ends + planars;
 
-                let (wl, wr) = (pos - lo, hi - pos);
-                let pl = 2.0 * (cap + wl * rim) * inv_sa;
-                let pr = 2.0 * (cap + wr * rim) * inv_sa;
+                let (wl, wr, pl, pr) = ac.sides(pos);
                 let mut consider = |l: u32, r: u32, planar_left: bool| {
-                    // A flat side holding nothing leaves the other side the whole node.
-                    if (wl == 0.0 && l == 0) || (wr == 0.0 && r == 0) {
-                        return;
-                    }
-                    let c = self.ctx.cost(pl, pr, l, r, wl, wr);
-                    if c < best_cost {
-                        best_cost = c;
-                        best = Some(Split {
-                            axis,
-                            pos,
-                            planar_left,
-                            cost: c,
-                        });
+                    if !useless(wl, wr, l, r) {
+                        best.offer(axis, pos, planar_left, self.ctx.cost(pl, pr, l, r, wl, wr));
                     }
                 };
                 consider(nl + planars, nr, true);
@@ -684,7 +677,7 @@ impl<P: KdPrimitives + ?Sized> Exact<'_, '_, P> {
                 nl += starts + planars;
             }
         }
-        best
+        best.0
     }
 
     /// Splits the node's events into the children's, both still sorted: events of primitives
