@@ -105,3 +105,35 @@ fn forcing_the_lens_on_a_pinhole_scene_changes_nothing_beyond_noise() {
         assert!(m < bound, "{name}: {m} vs {bound}");
     }
 }
+
+#[test]
+fn forcing_media_or_textures_on_a_scene_without_them_changes_nothing_beyond_noise() {
+    // With no medium and no texture in the scene, the forced variants take the same decisions
+    // on the same samples; the bound is 1 % of the difference between two independent renders,
+    // far below noise yet above any rounding a reordered sum could bring.
+    let small = [
+        ("render.width", "32"),
+        ("render.height", "32"),
+        ("render.spp", "16"),
+    ];
+    for name in ["cornell", "caustics"] {
+        let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("scenes/{name}.ron"));
+        let base = scene_file(&path, &small);
+        let plain = run(&base, Integrator::Wavefront).image();
+        let other = scene_file(&path, &[small[0], small[1], small[2], ("render.seed", "2")]);
+        let noise = prism::film::compare(&run(&other, Integrator::Wavefront).image(), &plain)
+            .unwrap()
+            .relmse;
+        for effect in [Effect::Media, Effect::Textures, Effect::NormalMaps] {
+            let mut s = scene_file(&path, &small);
+            assert!(!s.effects.has(effect));
+            s.effects.force(effect).unwrap();
+            let forced = run(&s, Integrator::Wavefront).image();
+            let m = prism::film::compare(&forced, &plain).unwrap().relmse;
+            assert!(
+                m < 0.01 * noise,
+                "{name} with {effect:?} forced: {m} vs noise {noise}"
+            );
+        }
+    }
+}
