@@ -3,7 +3,7 @@
 use glam::Vec3;
 use prism::integrator::Ctx;
 use prism::integrator::path::{camera_ray, shade};
-use prism::integrator::transport::{HeroLambda, Spectral, SpectralData};
+use prism::integrator::transport::{Spectral, SpectralData};
 use prism::spectrum::{IorModel, IorPreset, SampledSpectrum, Wavelengths};
 use std::path::Path;
 
@@ -21,10 +21,10 @@ fn monochromatic(scene: &prism::systems::RenderScene, lambda: f32) -> Vec<f32> {
             let mut sum = 0.0;
             for k in 0..spp {
                 let mut s = camera_ray::<Spectral, false>(&ctx, x, y, k);
-                s.lambda = HeroLambda::new(Wavelengths {
+                s.lambda = Wavelengths {
                     lambda: [lambda; 4],
                     pdf: [1.0, 0.0, 0.0, 0.0],
-                });
+                };
                 s.beta = SampledSpectrum([1.0, 0.0, 0.0, 0.0]);
                 while s.alive {
                     let hit = scene.intersect::<false>(&s.ray, f32::INFINITY, 0.0);

@@ -121,12 +121,10 @@ impl EmitSpec {
     }
 
     #[inline]
-    fn eval(&self, lam: &HeroLambda) -> SampledSpectrum {
-        let lam_d65 = lam.d65;
-        let lam = &lam.w;
+    fn eval(&self, lam: &Wavelengths) -> SampledSpectrum {
         match self {
             EmitSpec::Zero => SampledSpectrum::ZERO,
-            EmitSpec::Rgb(s) => SampledSpectrum(s.eval4_lit(lam.lambda, lam_d65)),
+            EmitSpec::Rgb(s) => SampledSpectrum(s.eval4(lam.lambda)),
             EmitSpec::Physical(EmitterSpectrum::Blackbody(b)) => {
                 SampledSpectrum(lam.lambda.map(|l| b.eval(l)))
             }
@@ -296,35 +294,18 @@ impl Transport for Rgb {
 #[derive(Clone, Copy, Debug)]
 pub struct Spectral;
 
-/// A spectral path's wavelengths, and the D65 illuminant at them that every RGB emitter is a
-/// multiple of: four table lookups once per path instead of at every emitter evaluation.
-#[derive(Clone, Copy, Debug, Default)]
-pub struct HeroLambda {
-    pub w: Wavelengths,
-    d65: [f32; 4],
-}
-
-impl HeroLambda {
-    pub fn new(w: Wavelengths) -> Self {
-        Self {
-            w,
-            d65: RgbIlluminant::illuminant4(w.lambda),
-        }
-    }
-}
-
 #[inline]
-fn sigmoid4(s: &RgbSigmoid, lam: &HeroLambda) -> SampledSpectrum {
-    SampledSpectrum(s.eval4(lam.w.lambda))
+fn sigmoid4(s: &RgbSigmoid, lam: &Wavelengths) -> SampledSpectrum {
+    SampledSpectrum(s.eval4(lam.lambda))
 }
 
 impl Transport for Spectral {
     type S = SampledSpectrum;
-    type Lambda = HeroLambda;
+    type Lambda = Wavelengths;
     type Med = SpectralMedium;
 
     #[inline]
-    fn wavelengths(ctx: &Ctx, pixel: u32, index: u32) -> HeroLambda {
+    fn wavelengths(ctx: &Ctx, pixel: u32, index: u32) -> Wavelengths {
         let u = ctx
             .sampler
             .get_1d(pixel, index, super::path::DIM_WAVELENGTH);
@@ -332,11 +313,11 @@ impl Transport for Spectral {
         if ctx.single_wavelength {
             lam.terminate_secondary();
         }
-        HeroLambda::new(lam)
+        lam
     }
     #[inline]
-    fn initial_beta(lam: &HeroLambda) -> SampledSpectrum {
-        SampledSpectrum(lam.w.pdf.map(|p| if p > 0.0 { 1.0 } else { 0.0 }))
+    fn initial_beta(lam: &Wavelengths) -> SampledSpectrum {
+        SampledSpectrum(lam.pdf.map(|p| if p > 0.0 { 1.0 } else { 0.0 }))
     }
     #[inline]
     fn reflectance(
@@ -344,7 +325,7 @@ impl Transport for Spectral {
         mat: u32,
         rgb: Vec3,
         textured: bool,
-        lam: &HeroLambda,
+        lam: &Wavelengths,
     ) -> SampledSpectrum {
         if textured {
             sigmoid4(&RgbSigmoid::from_rgb(rgb), lam)
@@ -358,20 +339,20 @@ impl Transport for Spectral {
         mat: u32,
         le: Vec3,
         tex: Option<Vec3>,
-        lam: &HeroLambda,
+        lam: &Wavelengths,
     ) -> SampledSpectrum {
         let spec = &ctx.spectral.emit[mat as usize];
         match (tex, spec) {
             (None, s) => s.eval(lam),
             // A textured RGB emitter: the modulated colour is the emitter's colour.
             (Some(_), EmitSpec::Rgb(_)) => {
-                SampledSpectrum(RgbIlluminant::from_rgb(le).eval4_lit(lam.w.lambda, lam.d65))
+                SampledSpectrum(RgbIlluminant::from_rgb(le).eval4(lam.lambda))
             }
             (Some(t), s) => s.eval(lam) * sigmoid4(&RgbSigmoid::from_rgb(t), lam),
         }
     }
     #[inline]
-    fn light_radiance(ctx: &Ctx, ls: &LightSample, lam: &HeroLambda) -> SampledSpectrum {
+    fn light_radiance(ctx: &Ctx, ls: &LightSample, lam: &Wavelengths) -> SampledSpectrum {
         match ls.source {
             LightSource::Area { material, tex, .. } => {
                 Self::emission(ctx, material, ls.radiance, tex, lam)
@@ -388,19 +369,18 @@ impl Transport for Spectral {
         light: u32,
         _: Vec3,
         scale: f32,
-        lam: &HeroLambda,
+        lam: &Wavelengths,
     ) -> SampledSpectrum {
         ctx.spectral.point[light as usize].eval(lam) * scale
     }
     #[inline]
-    fn environment(ctx: &Ctx, lam: &HeroLambda) -> SampledSpectrum {
+    fn environment(ctx: &Ctx, lam: &Wavelengths) -> SampledSpectrum {
         ctx.spectral
             .environment
             .map_or(SampledSpectrum::ZERO, |e| e.eval(lam))
     }
     #[inline]
-    fn eta(ior: &IorModel, lam: &mut HeroLambda, beta: &mut SampledSpectrum) -> f32 {
-        let lam = &mut lam.w;
+    fn eta(ior: &IorModel, lam: &mut Wavelengths, beta: &mut SampledSpectrum) -> f32 {
         match *ior {
             IorModel::Constant(n) => n,
             ref m => {
@@ -416,10 +396,10 @@ impl Transport for Spectral {
         }
     }
     #[inline]
-    fn medium(ctx: &Ctx, m: u32, lam: &HeroLambda) -> SpectralMedium {
+    fn medium(ctx: &Ctx, m: u32, lam: &Wavelengths) -> SpectralMedium {
         let (a, s, g) = &ctx.spectral.media[m as usize];
-        let sigma_a = SampledSpectrum(a.eval4(lam.w.lambda));
-        let sigma_s = SampledSpectrum(s.eval4(lam.w.lambda));
+        let sigma_a = SampledSpectrum(a.eval4(lam.lambda));
+        let sigma_s = SampledSpectrum(s.eval4(lam.lambda));
         SpectralMedium {
             sigma_s,
             sigma_t: sigma_a + sigma_s,
@@ -427,7 +407,7 @@ impl Transport for Spectral {
         }
     }
     #[inline]
-    fn to_rgb(l: SampledSpectrum, lam: &HeroLambda) -> Vec3 {
-        crate::spectrum::xyz_to_linear_srgb(crate::spectrum::to_xyz(&l, &lam.w))
+    fn to_rgb(l: SampledSpectrum, lam: &Wavelengths) -> Vec3 {
+        crate::spectrum::xyz_to_linear_srgb(crate::spectrum::to_xyz(&l, lam))
     }
 }

@@ -231,6 +231,17 @@ fn delta_e(s: RgbSigmoid, rgb: Vec3) -> f32 {
 /// it gives the D65 emitter of luminance 1.
 const D65_LUMINANCE: f32 = (D65_Y_SUM / CIE_Y_INTEGRAL as f64) as f32;
 
+/// D65 of luminance 1 at every nm of the visible range, for [`RgbIlluminant::illuminant4`].
+static ILLUMINANT_1NM: [f32; 471] = {
+    let mut t = [0.0f32; 471];
+    let mut i = 0;
+    while i < t.len() {
+        t[i] = (d65_at_nm(360 + i) / (D65_Y_SUM / CIE_Y_INTEGRAL as f64)) as f32;
+        i += 1;
+    }
+    t
+};
+
 /// An emission spectrum for an unbounded linear sRGB colour (pbrt-v4's
 /// `RGBIlluminantSpectrum`): `scale`·σ-spectrum of rgb/`scale`·D65, with
 /// `scale` = 2·max(rgb).
@@ -258,21 +269,25 @@ impl RgbIlluminant {
     /// [`RgbIlluminant::eval`] at four wavelengths.
     #[inline]
     pub fn eval4(&self, lambda: [f32; 4]) -> [f32; 4] {
-        self.eval4_lit(lambda, Self::illuminant4(lambda))
+        let s = self.0.eval4(lambda);
+        let illuminant = Self::illuminant4(lambda);
+        std::array::from_fn(|i| s[i] * illuminant[i])
     }
 
     /// The illuminant every RGB emitter is a multiple of (D65 of luminance 1) at four
-    /// wavelengths: a path computes it once and passes it to [`RgbIlluminant::eval4_lit`].
+    /// wavelengths, from a 1 nm table over the visible range (D65 is linear between its 5 nm
+    /// entries, so the finer table interpolates to the same function).
     #[inline]
     pub fn illuminant4(lambda: [f32; 4]) -> [f32; 4] {
-        lambda.map(|l| d65(l) / D65_LUMINANCE)
-    }
-
-    /// [`RgbIlluminant::eval4`] with the illuminant already evaluated at `lambda`.
-    #[inline]
-    pub fn eval4_lit(&self, lambda: [f32; 4], illuminant: [f32; 4]) -> [f32; 4] {
-        let s = self.0.eval4(lambda);
-        std::array::from_fn(|i| s[i] * illuminant[i])
+        lambda.map(|l| {
+            let x = l - LAMBDA_MIN;
+            if !(x >= 0.0 && x <= (ILLUMINANT_1NM.len() - 1) as f32) {
+                return 0.0;
+            }
+            let i = (x as usize).min(ILLUMINANT_1NM.len() - 2);
+            let f = x - i as f32;
+            ILLUMINANT_1NM[i] + (ILLUMINANT_1NM[i + 1] - ILLUMINANT_1NM[i]) * f
+        })
     }
 }
 
@@ -780,6 +795,24 @@ impl Table {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn tabulated_illuminant_is_d65_of_luminance_one() {
+        // The 1 nm table against the 5 nm D65 interpolated directly, off and on the nodes.
+        for k in 0..=4700 {
+            let l = LAMBDA_MIN + k as f32 * 0.1;
+            let got = RgbIlluminant::illuminant4([l; 4])[0];
+            let want = d65(l) / D65_LUMINANCE;
+            assert!(
+                (got - want).abs() <= 2e-6 * want.max(1.0),
+                "{l} nm: {got} vs {want}"
+            );
+        }
+        assert_eq!(
+            RgbIlluminant::illuminant4([359.0, 831.0, f32::NAN, 830.0])[..3],
+            [0.0; 3]
+        );
+    }
 
     #[test]
     fn sigmoid_is_precise_and_saturates() {
