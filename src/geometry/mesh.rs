@@ -496,9 +496,15 @@ impl TriangleMesh {
     /// Closest hit with `t` in (0, t_max).
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<MeshHit> {
-        let frame = RayFrame::new(ray)?;
+        if !RayFrame::accepts(ray) {
+            return None;
+        }
+        // Built at the first triangle: most rays that reach a mesh's box in a scene miss the
+        // mesh without testing one, and the frame's setup branches on the ray's direction.
+        let mut frame = None;
         let mut best = None;
         self.tree.closest_hit(ray, t_max, |i, limit| {
+            let frame = frame.get_or_insert_with(|| RayFrame::build(ray));
             let (t, b1, b2) = frame.hit(&self.tris[i as usize], limit)?;
             best = Some(MeshHit { t, tri: i, b1, b2 });
             Some(t)
@@ -509,10 +515,12 @@ impl TriangleMesh {
     /// Whether anything lies on the ray with `t` in (0, t_max).
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        let Some(frame) = RayFrame::new(ray) else {
+        if !RayFrame::accepts(ray) {
             return false;
-        };
+        }
+        let mut frame = None;
         self.tree.any_hit(ray, t_max, |i, limit| {
+            let frame = frame.get_or_insert_with(|| RayFrame::build(ray));
             frame.hit(&self.tris[i as usize], limit).is_some()
         })
     }
@@ -739,10 +747,19 @@ impl RayFrame {
     /// `None` for a ray with a zero or non-finite direction or a non-finite origin.
     #[inline]
     pub fn new(ray: &Ray) -> Option<Self> {
+        Self::accepts(ray).then(|| Self::build(ray))
+    }
+
+    /// Whether [`RayFrame::new`] gives a frame for this ray.
+    #[inline]
+    pub fn accepts(ray: &Ray) -> bool {
+        ray.d.is_finite() && ray.o.is_finite() && ray.d != Vec3::ZERO
+    }
+
+    /// The frame of a ray that [`RayFrame::accepts`].
+    #[inline]
+    fn build(ray: &Ray) -> Self {
         let d = ray.d;
-        if !d.is_finite() || !ray.o.is_finite() || d == Vec3::ZERO {
-            return None;
-        }
         let a = d.abs();
         let kz = if a.x > a.y {
             if a.x > a.z { 0 } else { 2 }
@@ -764,13 +781,13 @@ impl RayFrame {
         my[ky] = 1.0;
         my[kz] = -sy;
         mz[kz] = sz;
-        Some(Self {
+        Self {
             o: ray.o,
             mx,
             my,
             mz,
             dz: d[kz].abs(),
-        })
+        }
     }
 
     /// `(t, b1, b2)` of a hit with `t` in (0, t_max).
