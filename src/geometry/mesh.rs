@@ -731,13 +731,16 @@ fn is_closed_surface(indices: &[[u32; 3]], weld: &[u32]) -> bool {
 /// other acceleration structures can be measured with the same triangle test.
 #[derive(Clone, Copy, Debug)]
 pub struct RayFrame {
-    o: Vec3,
-    /// Rows of the permute-and-shear: `x' = p[kx] − Sx p[kz]`, `y' = p[ky] − Sy p[kz]`,
-    /// `z' = Sz p[kz]`. As dot products with these rows (one 1, one −S, one 0; or one Sz) they
-    /// round exactly as the paper's component form, with no per-triangle indexing.
-    mx: Vec3,
-    my: Vec3,
-    mz: Vec3,
+    /// The axes that become x, y and z: z is the direction's largest component.
+    k: [usize; 3],
+    /// The origin's components along `k`.
+    o: [f32; 3],
+    /// Shear: `x' = p[kx] − Sx p[kz]`, `y' = p[ky] − Sy p[kz]`, `z' = Sz p[kz]`, with `p`
+    /// relative to the origin; reading the vertices' components through `k` costs nothing
+    /// more than loading them.
+    sx: f32,
+    sy: f32,
+    sz: f32,
     /// |d[kz]|: turns the sheared z (a distance along the ray in units of t) back into the
     /// length unit of x and y for the error bounds.
     dz: f32,
@@ -759,8 +762,9 @@ impl RayFrame {
     /// The frame of a ray that [`RayFrame::accepts`].
     #[inline]
     fn build(ray: &Ray) -> Self {
-        let d = ray.d;
-        let a = d.abs();
+        let d = ray.d.to_array();
+        let o = ray.o.to_array();
+        let a = ray.d.abs();
         let kz = if a.x > a.y {
             if a.x > a.z { 0 } else { 2 }
         } else if a.y > a.z {
@@ -774,31 +778,35 @@ impl RayFrame {
         if d[kz] < 0.0 {
             std::mem::swap(&mut kx, &mut ky);
         }
-        let (sx, sy, sz) = (d[kx] / d[kz], d[ky] / d[kz], 1.0 / d[kz]);
-        let (mut mx, mut my, mut mz) = (Vec3::ZERO, Vec3::ZERO, Vec3::ZERO);
-        mx[kx] = 1.0;
-        mx[kz] = -sx;
-        my[ky] = 1.0;
-        my[kz] = -sy;
-        mz[kz] = sz;
         Self {
-            o: ray.o,
-            mx,
-            my,
-            mz,
+            k: [kx, ky, kz],
+            o: [o[kx], o[ky], o[kz]],
+            sx: d[kx] / d[kz],
+            sy: d[ky] / d[kz],
+            sz: 1.0 / d[kz],
             dz: d[kz].abs(),
         }
+    }
+
+    /// A vertex relative to the origin, permuted and sheared: (x', y', z before scaling).
+    #[inline]
+    fn shear(&self, v: &Vec3) -> (f32, f32, f32) {
+        let v: &[f32; 3] = v.as_ref();
+        let [kx, ky, kz] = self.k;
+        let z = v[kz] - self.o[2];
+        (
+            v[kx] - self.o[0] - self.sx * z,
+            v[ky] - self.o[1] - self.sy * z,
+            z,
+        )
     }
 
     /// `(t, b1, b2)` of a hit with `t` in (0, t_max).
     #[inline]
     pub fn hit(&self, tri: &[Vec3; 3], t_max: f32) -> Option<(f32, f32, f32)> {
-        let a = tri[0] - self.o;
-        let b = tri[1] - self.o;
-        let c = tri[2] - self.o;
-        let (ax, ay) = (a.dot(self.mx), a.dot(self.my));
-        let (bx, by) = (b.dot(self.mx), b.dot(self.my));
-        let (cx, cy) = (c.dot(self.mx), c.dot(self.my));
+        let (ax, ay, az) = self.shear(&tri[0]);
+        let (bx, by, bz) = self.shear(&tri[1]);
+        let (cx, cy, cz) = self.shear(&tri[2]);
 
         let mut u = cx * by - cy * bx;
         let mut v = ax * cy - ay * cx;
@@ -822,7 +830,7 @@ impl RayFrame {
             return None;
         }
 
-        let (az, bz, cz) = (a.dot(self.mz), b.dot(self.mz), c.dot(self.mz));
+        let (az, bz, cz) = (self.sz * az, self.sz * bz, self.sz * cz);
         let t_scaled = u * az + v * bz + w * cz;
         // The range test before dividing, with det's sign folded in.
         if det < 0.0 {

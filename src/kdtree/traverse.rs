@@ -122,12 +122,10 @@ impl KdTree {
         // to a chain of compares on the axis, two more unpredictable branches per node.
         let o = [ray.o.x, ray.o.y, ray.o.z, 0.0];
         let inv = [inv_d.x, inv_d.y, inv_d.z, 0.0];
-        let neg = [
-            usize::from(ray.d.x < 0.0),
-            usize::from(ray.d.y < 0.0),
-            usize::from(ray.d.z < 0.0),
-            0,
-        ];
+        // Bit `axis` set where the direction is negative.
+        let neg = u32::from(ray.d.x < 0.0)
+            | u32::from(ray.d.y < 0.0) << 1
+            | u32::from(ray.d.z < 0.0) << 2;
         let mut limit = t_max;
         let mut stack = [Todo {
             node: 0,
@@ -142,9 +140,12 @@ impl KdTree {
                 let axis = node.axis() & 3;
                 let t_plane = (node.split() - o[axis]) * inv[axis];
                 // Moving up the axis the below child comes first, moving down the above one.
-                let children = [index + 1, node.above() as usize];
-                let near = children[neg[axis]];
-                let far = children[1 - neg[axis]];
+                let (below, above) = (index + 1, node.above() as usize);
+                let (near, far) = if neg >> axis & 1 == 0 {
+                    (below, above)
+                } else {
+                    (above, below)
+                };
                 // A plane exactly at either end of the segment visits both sides, so a
                 // primitive touching the plane from either is seen (as `walk_any` does).
                 // Branches, not selects: a select makes every node load wait for the plane
@@ -166,9 +167,13 @@ impl KdTree {
                 continue;
             }
 
-            match leaf(self.leaf_prims(node), t1, limit) {
-                Some(l) => limit = l,
-                None => return,
+            // Empty leaves (over half of a mesh tree's) need no call: a hit found earlier
+            // that ends the walk is caught by the check on the next pending entry.
+            if node.prim_count() != 0 {
+                match leaf(self.leaf_prims(node), t1, limit) {
+                    Some(l) => limit = l,
+                    None => return,
+                }
             }
             if sp == 0 {
                 return;
