@@ -316,6 +316,11 @@ impl TriangleMesh {
     pub fn kd_params() -> KdParams {
         KdParams {
             empty_bonus: 0.3,
+            // On a dense mesh the SAH never makes a leaf by itself (each split still looks
+            // cheaper), so the depth limit shapes the tree and each extra level doubles it.
+            // At 8 + log2(N) rather than pbrt's 8 + 1.3 log2(N), builds of the full bunny and
+            // a 330k-triangle sphere were 3x faster and diffuse rays no slower.
+            depth_per_doubling: 1.0,
             // Binned down to a dozen references, then exact: the event sweep below 4096 made
             // the full bunny's build about 3x slower for a 1.7% lower SAH cost.
             binned_above: 0,

@@ -9,6 +9,7 @@ use super::node::KdNode;
 use super::{KdParams, KdPrimitives, KdStats, MAX_DEPTH};
 
 use crate::geometry::Aabb;
+use glam::Vec3;
 
 const AXIS_SHIFT: u32 = 62;
 const POS_SHIFT: u32 = 30;
@@ -488,6 +489,28 @@ impl<P: KdPrimitives + ?Sized> Ctx<'_, P> {
         if sa <= 0.0 {
             return None;
         }
+        // One pass bins all three axes (three passes over the references were most of the
+        // build); a flat axis gets scale 0 and is skipped below.
+        let ext = cell.diagonal();
+        let scale = Vec3::select(
+            ext.cmpgt(Vec3::ZERO),
+            Vec3::splat(BINS as f32) / ext,
+            Vec3::ZERO,
+        );
+        let mut starts = [[0u32; BINS]; 3];
+        let mut ends = [[0u32; BINS]; 3];
+        let mut span = Aabb::EMPTY;
+        // Negative offsets (rounding at the cell's low face) saturate to bin 0.
+        let bin = |x: f32| (x as usize).min(BINS - 1);
+        for r in refs {
+            let s = ((r.b.min - cell.min) * scale).to_array();
+            let e = ((r.b.max - cell.min) * scale).to_array();
+            for a in 0..3 {
+                starts[a][bin(s[a])] += 1;
+                ends[a][bin(e[a])] += 1;
+            }
+            span = span.union(&r.b);
+        }
         let mut best = Cheapest(None);
         for axis in 0..3 {
             let ac = AxisCell::new(cell, axis, 1.0 / sa);
@@ -495,17 +518,8 @@ impl<P: KdPrimitives + ?Sized> Ctx<'_, P> {
             if hi <= lo {
                 continue;
             }
-            let scale = BINS as f32 / (hi - lo);
-            let bin = |x: f32| (((x - lo) * scale) as usize).min(BINS - 1);
-            let mut starts = [0u32; BINS];
-            let mut ends = [0u32; BINS];
-            let (mut first, mut last) = (f32::INFINITY, f32::NEG_INFINITY);
-            for r in refs {
-                starts[bin(r.b.min[axis])] += 1;
-                ends[bin(r.b.max[axis])] += 1;
-                first = first.min(r.b.min[axis]);
-                last = last.max(r.b.max[axis]);
-            }
+            let (starts, ends) = (&starts[axis], &ends[axis]);
+            let (first, last) = (span.min[axis], span.max[axis]);
             // Bins cut empty space only to their width; the planes through the references'
             // extreme faces cut it exactly, with all references on one side (flat ones in
             // the plane go with them).

@@ -54,8 +54,10 @@ pub struct KdParams {
     pub empty_bonus: f32,
     /// Nodes with at most this many primitives become leaves.
     pub max_leaf_prims: u32,
-    /// Depth limit; `None` picks 8 + 1.3 log2(N). Clamped to [`MAX_DEPTH`].
+    /// Depth limit; `None` picks 8 + `depth_per_doubling` · log2(N). Clamped to [`MAX_DEPTH`].
     pub max_depth: Option<u32>,
+    /// Levels the automatic depth limit grows by each time N doubles (pbrt: 1.3).
+    pub depth_per_doubling: f32,
     /// Nodes with more primitive references than this pick their split from binned counts
     /// (and build their children in parallel when large); smaller ones sweep exact events.
     pub binned_above: usize,
@@ -70,6 +72,7 @@ impl Default for KdParams {
             empty_bonus: 0.5,
             max_leaf_prims: 1,
             max_depth: None,
+            depth_per_doubling: 1.3,
             binned_above: 4096,
         }
     }
@@ -78,9 +81,9 @@ impl Default for KdParams {
 impl KdParams {
     /// The depth limit a build over `n` primitives uses.
     pub fn depth_limit(&self, n: usize) -> u32 {
-        let d = self
-            .max_depth
-            .unwrap_or_else(|| (8.0 + 1.3 * (n.max(1) as f64).log2()).round() as u32);
+        let d = self.max_depth.unwrap_or_else(|| {
+            (8.0 + f64::from(self.depth_per_doubling) * (n.max(1) as f64).log2()).round() as u32
+        });
         build::clamp_depth(d)
     }
 }
