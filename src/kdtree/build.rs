@@ -534,9 +534,16 @@ impl<P: KdPrimitives + ?Sized> Ctx<'_, P> {
                 best.offer(axis, pos, planar_left, self.cost(pl, pr, l, r, wl, wr));
             }
             let (mut nl, mut nr) = (0u32, n);
+            let used = |k: usize| starts[k] | ends[k] != 0;
             for k in 1..BINS {
                 nl += starts[k - 1];
                 nr -= ends[k - 1];
+                // Between bins where no face falls the counts stay the same and the cost is
+                // linear in the position, so its minimum over such a run of planes is at one
+                // of the run's ends: only those are priced (most bins of a small node are empty).
+                if !(k == 1 || k == BINS - 1 || used(k - 1) || used(k)) {
+                    continue;
+                }
                 let pos = lo + (hi - lo) * (k as f32 / BINS as f32);
                 if pos <= lo || pos >= hi {
                     continue;
