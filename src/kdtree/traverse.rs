@@ -95,21 +95,22 @@ impl KdTree {
         let inv_d = Vec3::ONE / ray.d;
         if inv_d.is_finite() && ray.d.is_finite() && ray.o.is_finite() {
             if let Some((t0, t1)) = self.bounds.intersect_oblique(ray, inv_d, t_max) {
-                self.walk_oblique::<N>(ray, inv_d, t0, t1, t_max, leaf);
+                self.walk_from::<N, true>(ray, inv_d, t0, t1, t_max, leaf);
             }
         } else if let Some((t0, t1)) = self.bounds.intersect_p(ray, inv_d, t_max) {
-            self.walk_any::<N>(ray, inv_d, t0, t1, t_max, leaf);
+            self.walk_from::<N, false>(ray, inv_d, t0, t1, t_max, leaf);
         }
     }
 
-    /// The walk for rays with no zero direction component, which covers nearly all of them:
-    /// a plane distance is then never NaN, and the child the ray meets first depends only on
-    /// the sign of its direction along the split axis. That makes the near/far choice a table
-    /// lookup instead of a comparison with the origin, and leaves two tests per node (plane
-    /// before or beyond the segment), which matter for incoherent rays, whose branches
-    /// mispredict often.
+    /// The walk from the root over the ray's range `[t0, t1]` in the tree's box.
+    ///
+    /// `OBLIQUE` rays have no zero direction component, which covers nearly all of them: a
+    /// plane distance is then never NaN, and the child the ray meets first depends only on the
+    /// sign of its direction along the split axis. That leaves two tests per node (plane before
+    /// or beyond the segment), which matter for incoherent rays, whose branches mispredict
+    /// often. Other rays, parallel to split planes or lying in them, take the general step.
     #[inline]
-    fn walk_oblique<const N: usize>(
+    fn walk_from<const N: usize, const OBLIQUE: bool>(
         &self,
         ray: &Ray,
         inv_d: Vec3,
@@ -138,89 +139,43 @@ impl KdTree {
             let node = &self.nodes[index];
             if !node.is_leaf() {
                 let axis = node.axis() & 3;
-                let t_plane = (node.split() - o[axis]) * inv[axis];
-                // Moving up the axis the below child comes first, moving down the above one.
+                let split = node.split();
+                let t_plane = (split - o[axis]) * inv[axis];
                 let (below, above) = (index + 1, node.above() as usize);
-                let (near, far) = if neg >> axis & 1 == 0 {
+                if OBLIQUE {
+                    // Moving up the axis the below child comes first, moving down the above.
+                    let (near, far) = if neg >> axis & 1 == 0 {
+                        (below, above)
+                    } else {
+                        (above, below)
+                    };
+                    // A plane exactly at either end of the segment visits both sides, so a
+                    // primitive touching the plane from either is seen (as the general step
+                    // does). Branches, not selects: a select makes every node load wait for
+                    // the plane test, and that measured slower than the mispredictions.
+                    if t_plane < t0 {
+                        index = far;
+                    } else if t_plane > t1 {
+                        index = near;
+                    } else {
+                        stack[sp] = Todo {
+                            node: far as u32,
+                            t0: t_plane,
+                            t1,
+                        };
+                        sp += 1;
+                        index = near;
+                        t1 = t_plane;
+                    }
+                    continue;
+                }
+                // From on the plane, the side the ray heads into comes first.
+                let d = [ray.d.x, ray.d.y, ray.d.z, 0.0];
+                let below_first = o[axis] < split || (o[axis] == split && d[axis] <= 0.0);
+                let (first, second) = if below_first {
                     (below, above)
                 } else {
                     (above, below)
-                };
-                // A plane exactly at either end of the segment visits both sides, so a
-                // primitive touching the plane from either is seen (as `walk_any` does).
-                // Branches, not selects: a select makes every node load wait for the plane
-                // test, and that measured slower than the mispredictions it saves.
-                if t_plane < t0 {
-                    index = far;
-                } else if t_plane > t1 {
-                    index = near;
-                } else {
-                    stack[sp] = Todo {
-                        node: far as u32,
-                        t0: t_plane,
-                        t1,
-                    };
-                    sp += 1;
-                    index = near;
-                    t1 = t_plane;
-                }
-                continue;
-            }
-
-            // Empty leaves (over half of a mesh tree's) need no call: a hit found earlier
-            // that ends the walk is caught by the check on the next pending entry.
-            if node.prim_count() != 0 {
-                match leaf(self.leaf_prims(node), t1, limit) {
-                    Some(l) => limit = l,
-                    None => return,
-                }
-            }
-            if sp == 0 {
-                return;
-            }
-            sp -= 1;
-            let todo = stack[sp];
-            if todo.t0 > limit {
-                return;
-            }
-            index = todo.node as usize;
-            t0 = todo.t0;
-            t1 = todo.t1;
-        }
-    }
-
-    /// The walk for any ray, including ones parallel to split planes or lying in them.
-    #[inline]
-    fn walk_any<const N: usize>(
-        &self,
-        ray: &Ray,
-        inv_d: Vec3,
-        mut t0: f32,
-        mut t1: f32,
-        t_max: f32,
-        mut leaf: impl FnMut(&[u32], f32, f32) -> Option<f32>,
-    ) {
-        let mut limit = t_max;
-        let mut stack = [Todo {
-            node: 0,
-            t0: 0.0,
-            t1: 0.0,
-        }; N];
-        let mut sp = 0;
-        let mut index = 0usize;
-        loop {
-            let node = &self.nodes[index];
-            if !node.is_leaf() {
-                let axis = node.axis();
-                let split = node.split();
-                let o = ray.o[axis];
-                let t_plane = (split - o) * inv_d[axis];
-                // From on the plane, the side the ray heads into comes first.
-                let below_first = o < split || (o == split && ray.d[axis] <= 0.0);
-                let (first, second) = if below_first {
-                    (index + 1, node.above() as usize)
-                } else {
-                    (node.above() as usize, index + 1)
                 };
                 if t_plane.is_nan() {
                     // 0 · inf: the ray lies in the plane, touching both children all along.
@@ -248,9 +203,13 @@ impl KdTree {
                 continue;
             }
 
-            match leaf(self.leaf_prims(node), t1, limit) {
-                Some(l) => limit = l,
-                None => return,
+            // Empty leaves (over half of a mesh tree's) need no call: a hit found earlier
+            // that ends the walk is caught by the check on the next pending entry.
+            if node.prim_count() != 0 {
+                match leaf(self.leaf_prims(node), t1, limit) {
+                    Some(l) => limit = l,
+                    None => return,
+                }
             }
             // Pending entries start no earlier than the top one, so one past the limit ends it.
             if sp == 0 {
