@@ -15,6 +15,17 @@ struct Todo {
 // Each interior node on the current path pushes at most one entry, so the depth bounds the stack.
 const STACK: usize = MAX_DEPTH as usize;
 
+/// Pushes a far child to visit later over `[t0, t1]`.
+#[inline(always)]
+fn push<const N: usize>(stack: &mut [Todo; N], sp: &mut usize, node: usize, t0: f32, t1: f32) {
+    stack[*sp] = Todo {
+        node: node as u32,
+        t0,
+        t1,
+    };
+    *sp += 1;
+}
+
 impl KdTree {
     /// Closest hit. Calls `isect(prim, t_max_now)` for candidate primitives in front-to-back
     /// order; the callback returns `Some(t)` only for a hit with `0 < t < t_max_now` (the caller
@@ -158,12 +169,7 @@ impl KdTree {
                     } else if t_plane > t1 {
                         index = near;
                     } else {
-                        stack[sp] = Todo {
-                            node: far as u32,
-                            t0: t_plane,
-                            t1,
-                        };
-                        sp += 1;
+                        push(&mut stack, &mut sp, far, t_plane, t1);
                         index = near;
                         t1 = t_plane;
                     }
@@ -179,24 +185,14 @@ impl KdTree {
                 };
                 if t_plane.is_nan() {
                     // 0 · inf: the ray lies in the plane, touching both children all along.
-                    stack[sp] = Todo {
-                        node: second as u32,
-                        t0,
-                        t1,
-                    };
-                    sp += 1;
+                    push(&mut stack, &mut sp, second, t0, t1);
                     index = first;
                 } else if t_plane > t1 || t_plane <= 0.0 || t_plane == f32::INFINITY {
                     index = first;
                 } else if t_plane < t0 {
                     index = second;
                 } else {
-                    stack[sp] = Todo {
-                        node: second as u32,
-                        t0: t_plane,
-                        t1,
-                    };
-                    sp += 1;
+                    push(&mut stack, &mut sp, second, t_plane, t1);
                     index = first;
                     t1 = t_plane;
                 }
