@@ -137,3 +137,49 @@ impl Aabb {
 
 /// pbrt's γ(3) = 3u / (1 − 3u), u the unit roundoff of f32.
 pub const GAMMA3: f32 = 3.0 * (f32::EPSILON * 0.5) / (1.0 - 3.0 * (f32::EPSILON * 0.5));
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn oblique_slab_test_equals_the_general_one() {
+        // Deterministic xorshift: no dev-dependency in unit tests.
+        let mut state = 0x9e37_79b9_7f4a_7c15u64;
+        let mut f = move || {
+            state ^= state << 13;
+            state ^= state >> 7;
+            state ^= state << 17;
+            (state >> 40) as f32 / (1u64 << 24) as f32 * 2.0 - 1.0
+        };
+        let b = Aabb::new(Vec3::new(-1.0, -0.5, 0.0), Vec3::new(2.0, 0.5, 0.25));
+        let (mut checked, mut hits) = (0, 0);
+        for _ in 0..100_000 {
+            let o = Vec3::new(f(), f(), f()) * 3.0;
+            // Half aimed at a point of the box (hits, some from inside), half anywhere.
+            let aim = Vec3::new(f(), f(), f()) * 0.5 + 0.5;
+            let target = b.min + (b.max - b.min) * aim;
+            let d = if f() < 0.0 {
+                target - o
+            } else {
+                Vec3::new(f(), f(), f())
+            };
+            if d.x == 0.0 || d.y == 0.0 || d.z == 0.0 {
+                continue;
+            }
+            let ray = Ray::new(o, d);
+            let inv = Vec3::ONE / d;
+            for t_max in [f32::INFINITY, 1.0] {
+                let want = b.intersect_p(&ray, inv, t_max);
+                assert_eq!(b.intersect_oblique(&ray, inv, t_max), want, "{ray:?}");
+                checked += 1;
+                hits += usize::from(want.is_some());
+            }
+        }
+        // Both outcomes must be exercised for the comparison to mean anything.
+        assert!(
+            hits > checked / 10 && hits < checked * 9 / 10,
+            "{hits} of {checked}"
+        );
+    }
+}

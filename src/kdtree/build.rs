@@ -508,8 +508,8 @@ impl<P: KdPrimitives + ?Sized> Ctx<'_, P> {
         if sa <= 0.0 {
             return None;
         }
-        // One pass bins all three axes (three passes over the references were most of the
-        // build); a flat axis gets scale 0 and is skipped below.
+        // One pass bins all three axes, so each reference is read once rather than three
+        // times; a flat axis gets scale 0 and is skipped below.
         let ext = cell.diagonal();
         let scale = Vec3::select(
             ext.cmpgt(Vec3::ZERO),
