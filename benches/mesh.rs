@@ -99,7 +99,7 @@ fn builds(c: &mut Criterion) {
     for (name, m) in meshes.iter().filter(|(n, _)| n.starts_with("bunny")) {
         eprintln!(
             "kd_build/{name}: exact events everywhere: SAH cost {:.2}",
-            m.build_tree(&exact).sah_cost(&params)
+            m.build_tree(&exact).tree.sah_cost(&params)
         );
         g.bench_function(format!("{name}_exact_events_1t"), |b| {
             b.iter(|| pool.install(|| m.build_tree(&exact)))

@@ -340,7 +340,7 @@ fn mesh_tree_is_the_same_whatever_the_thread_count() {
             .num_threads(threads)
             .build()
             .unwrap()
-            .install(|| mesh.build_tree(&params))
+            .install(|| mesh.build_tree(&params).tree)
     };
     let (one, two) = (on(1), on(2));
     assert_eq!(one.raw(), two.raw());

@@ -26,7 +26,7 @@
 //! split vertices at UV seams (and OBJ groups), and neither may show in the shading.
 
 use super::{Aabb, Ray};
-use crate::kdtree::{KdParams, KdPrimitives, KdStats, KdTree, MAX_PRIMS};
+use crate::kdtree::{KdParams, KdPrimitives, KdStats, KdTree, Leaf, MAX_PRIMS};
 use glam::{DVec3, Vec2, Vec3};
 use std::fmt;
 use std::path::{Path, PathBuf};
@@ -286,6 +286,8 @@ pub struct TriangleMesh {
     /// Per-vertex UVs; a triangle with a non-finite corner uses `DEFAULT_UV`.
     uvs: Option<Vec<Vec2>>,
     tree: KdTree,
+    /// The triangles of the tree's leaf runs, four to a block, laid out beside its index array.
+    blocks: Vec<Tri4>,
     bounds: Aabb,
     area: f32,
     stats: MeshStats,
@@ -413,7 +415,7 @@ impl TriangleMesh {
         let bounds = tris
             .iter()
             .fold(Aabb::EMPTY, |b, t| b.union(&Aabb::from_points(t)));
-        let tree = KdTree::build(&TriBoxes(&tris), params);
+        let MeshTree { tree, blocks } = build_mesh_tree(&tris, params);
 
         let stats = MeshStats {
             vertices: nv,
@@ -434,6 +436,7 @@ impl TriangleMesh {
             normals,
             uvs,
             tree,
+            blocks,
             bounds,
             area: area as f32,
             stats,
@@ -454,9 +457,10 @@ impl TriangleMesh {
         &self.tree
     }
 
-    /// Builds the mesh's kd-tree again (with other parameters, or to time the build alone).
-    pub fn build_tree(&self, params: &KdParams) -> KdTree {
-        KdTree::build(&TriBoxes(&self.tris), params)
+    /// Builds the mesh's kd-tree and leaf blocks again (with other parameters, or to time the
+    /// build alone).
+    pub fn build_tree(&self, params: &KdParams) -> MeshTree {
+        build_mesh_tree(&self.tris, params)
     }
 
     pub fn triangle_count(&self) -> usize {
@@ -508,11 +512,18 @@ impl TriangleMesh {
         // mesh without testing one, and the frame's setup branches on the ray's direction.
         let mut frame = None;
         let mut best = None;
-        self.tree.closest_hit(ray, t_max, |i, limit| {
+        self.tree.closest_hit_leaves(ray, t_max, |leaf, mut limit| {
             let frame = frame.get_or_insert_with(|| RayFrame::build(ray));
-            let (t, b1, b2) = frame.hit(&self.tris[i as usize], limit)?;
-            best = Some(MeshHit { t, tri: i, b1, b2 });
-            Some(t)
+            let mut found = None;
+            self.leaf_candidates(frame, leaf, |i, tri| {
+                if let Some((t, b1, b2)) = frame.hit(tri, limit) {
+                    limit = t;
+                    found = Some(t);
+                    best = Some(MeshHit { t, tri: i, b1, b2 });
+                }
+                false
+            });
+            found
         });
         best
     }
@@ -524,10 +535,40 @@ impl TriangleMesh {
             return false;
         }
         let mut frame = None;
-        self.tree.any_hit(ray, t_max, |i, limit| {
+        self.tree.any_hit_leaves(ray, t_max, |leaf, limit| {
             let frame = frame.get_or_insert_with(|| RayFrame::build(ray));
-            frame.hit(&self.tris[i as usize], limit).is_some()
+            self.leaf_candidates(frame, leaf, |_, tri| frame.hit(tri, limit).is_some())
         })
+    }
+
+    /// Calls `f(triangle, corners)` in order for the triangles of a leaf that the ray may hit,
+    /// until it returns true (and then returns true). The triangles of a run are screened four
+    /// at a time by the first half of the watertight test, which computes exactly what
+    /// [`RayFrame::hit`] computes, so it only skips triangles that `hit` would miss too.
+    #[inline]
+    fn leaf_candidates(
+        &self,
+        frame: &RayFrame,
+        leaf: Leaf<'_>,
+        mut f: impl FnMut(u32, &[Vec3; 3]) -> bool,
+    ) -> bool {
+        let Some(run) = leaf.run else {
+            return leaf.prims.iter().any(|&i| f(i, &self.tris[i as usize]));
+        };
+        let first = run as usize / 4;
+        let n = leaf.prims.len();
+        for (b, block) in self.blocks[first..first + n.div_ceil(4)].iter().enumerate() {
+            let lanes = (n - 4 * b).min(4);
+            let mut mask = frame.screen(block) & ((1 << lanes) - 1);
+            while mask != 0 {
+                let lane = mask.trailing_zeros() as usize;
+                mask &= mask - 1;
+                if f(leaf.prims[4 * b + lane], &block.corners(lane)) {
+                    return true;
+                }
+            }
+        }
+        false
     }
 
     /// Closest hit by testing every triangle: the reference the tree is checked against.
@@ -731,6 +772,51 @@ fn is_closed_surface(indices: &[[u32; 3]], weld: &[u32]) -> bool {
         .all(|&e| edges.binary_search(&e.rotate_right(32)).is_ok())
 }
 
+/// Four triangles of a leaf run, component-major: `c[corner][axis][lane]`, so that the
+/// shear and the edge functions of the watertight test run on all four at once.
+#[derive(Clone, Copy, Debug, Default)]
+#[repr(C, align(16))]
+pub struct Tri4 {
+    c: [[[f32; 4]; 3]; 3],
+}
+
+impl Tri4 {
+    #[inline]
+    fn corners(&self, lane: usize) -> [Vec3; 3] {
+        self.c.map(|[x, y, z]| Vec3::new(x[lane], y[lane], z[lane]))
+    }
+}
+
+/// A mesh's kd-tree with its leaf blocks.
+pub struct MeshTree {
+    pub tree: KdTree,
+    pub blocks: Vec<Tri4>,
+}
+
+/// Lanes per leaf block: [`KdParams::run_align`] of mesh trees.
+const LANES: u32 = 4;
+
+fn build_mesh_tree(tris: &[[Vec3; 3]], params: &KdParams) -> MeshTree {
+    let params = KdParams {
+        run_align: LANES,
+        ..*params
+    };
+    let tree = KdTree::build(&TriBoxes(tris), &params);
+    let mut blocks = vec![Tri4::default(); tree.index_len().div_ceil(LANES as usize)];
+    for (at, prims) in tree.runs() {
+        for (k, &p) in prims.iter().enumerate() {
+            let slot = at as usize + k;
+            let block = &mut blocks[slot / 4].c;
+            for (j, v) in tris[p as usize].iter().enumerate() {
+                for a in 0..3 {
+                    block[j][a][slot % 4] = v[a];
+                }
+            }
+        }
+    }
+    MeshTree { tree, blocks }
+}
+
 /// The constants of the watertight test for one ray: the translation to its origin and the
 /// permute-and-shear rows that carry the direction onto +z (Woop et al. 2013). Public so that
 /// other acceleration structures can be measured with the same triangle test.
@@ -804,6 +890,37 @@ impl RayFrame {
             v[ky] - self.o[1] - self.sy * z,
             z,
         )
+    }
+
+    /// Bit per lane of the block: set where the triangle may be hit, clear where the edge
+    /// functions have mixed signs (all nonzero), which [`RayFrame::hit`] rejects. Lane for lane
+    /// the same operations as `hit`, so the same roundings.
+    #[inline]
+    fn screen(&self, b: &Tri4) -> u32 {
+        // Clamped so the compiler sees the rows are in range (they are: k permutes 0..3).
+        let [kx, ky, kz] = self.k.map(|a| a.min(2));
+        let mut x = [[0.0f32; 4]; 3];
+        let mut y = [[0.0f32; 4]; 3];
+        for (j, corner) in b.c.iter().enumerate() {
+            for l in 0..4 {
+                let z = corner[kz][l] - self.o[2];
+                x[j][l] = corner[kx][l] - self.o[0] - self.sx * z;
+                y[j][l] = corner[ky][l] - self.o[1] - self.sy * z;
+            }
+        }
+        let [ax, bx, cx] = x;
+        let [ay, by, cy] = y;
+        let mut mask = 0;
+        for l in 0..4 {
+            let u = cx[l] * by[l] - cy[l] * bx[l];
+            let v = ax[l] * cy[l] - ay[l] * cx[l];
+            let w = bx[l] * ay[l] - by[l] * ax[l];
+            // `|` and `&`, not `||` and `&&`: no branch per lane.
+            let zero = (u == 0.0) | (v == 0.0) | (w == 0.0);
+            let mixed = ((u < 0.0) | (v < 0.0) | (w < 0.0)) & ((u > 0.0) | (v > 0.0) | (w > 0.0));
+            mask |= u32::from(zero | !mixed) << l;
+        }
+        mask
     }
 
     /// `(t, b1, b2)` of a hit with `t` in (0, t_max).

@@ -246,7 +246,7 @@ impl Frag {
         self.prim_refs += other.prim_refs;
     }
 
-    fn leaf(&mut self, prims: &mut [u32], depth: u32) {
+    fn leaf(&mut self, prims: &mut [u32], depth: u32, align: u32) {
         // Sorted, so a leaf's order does not depend on how the build reached it.
         prims.sort_unstable();
         let count = prims.len() as u32;
@@ -256,6 +256,10 @@ impl Frag {
             _ => {
                 let offset = u32::try_from(self.indices.len()).expect("kd-tree index count");
                 self.indices.extend_from_slice(prims);
+                // Every run starts aligned because every run before it ends padded, and so
+                // do fragments appended to one another.
+                let padded = self.indices.len().next_multiple_of(align as usize);
+                self.indices.resize(padded, prims[prims.len() - 1]);
                 KdNode::leaf(count, offset)
             }
         };
@@ -302,6 +306,7 @@ struct Ctx<'a, P: KdPrimitives + ?Sized> {
     max_leaf_prims: u32,
     max_depth: u32,
     binned_above: usize,
+    run_align: u32,
 }
 
 pub(crate) fn build<P: KdPrimitives + ?Sized>(prims: &P, params: &KdParams) -> Built {
@@ -332,6 +337,7 @@ pub(crate) fn build<P: KdPrimitives + ?Sized>(prims: &P, params: &KdParams) -> B
         max_leaf_prims: params.max_leaf_prims,
         max_depth: params.depth_limit(kept),
         binned_above: params.binned_above,
+        run_align: params.run_align.max(1),
     };
     let mut frag = Frag::default();
     if kept > 0 {
@@ -405,7 +411,7 @@ impl<P: KdPrimitives + ?Sized> Ctx<'_, P> {
         };
         let Some(split) = split.filter(|s| s.cost < self.intersect_cost * n as f32) else {
             let mut prims: Vec<u32> = refs.iter().map(|r| r.prim).collect();
-            out.leaf(&mut prims, depth);
+            out.leaf(&mut prims, depth, self.run_align);
             pool.put(refs);
             return;
         };
@@ -649,7 +655,7 @@ impl<P: KdPrimitives + ?Sized> Exact<'_, '_, P> {
             self.scratch
                 .extend(node_prims(&events).map(|k| self.ids[k as usize]));
             let mut prims = std::mem::take(&mut self.scratch);
-            self.out.leaf(&mut prims, depth);
+            self.out.leaf(&mut prims, depth, self.ctx.run_align);
             self.scratch = prims;
             return;
         };
@@ -885,7 +891,7 @@ mod tests {
     fn leaves_at(tree: &KdTree, p: Vec3, node: usize, out: &mut Vec<Vec<u32>>) {
         let n = tree.nodes[node];
         if n.is_leaf() {
-            out.push(tree.leaf_prims(&tree.nodes[node]).to_vec());
+            out.push(tree.leaf(&tree.nodes[node]).prims.to_vec());
             return;
         }
         let (a, s) = (n.axis(), n.split());

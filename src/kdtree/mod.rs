@@ -61,6 +61,10 @@ pub struct KdParams {
     /// Nodes with more primitive references than this pick their split from binned counts
     /// (and build their children in parallel when large); smaller ones sweep exact events.
     pub binned_above: usize,
+    /// Leaf runs of two or more primitives start at multiples of this in the index array
+    /// (padded with the run's last primitive), so that data a caller lays out beside that
+    /// array can be read in aligned blocks ([`KdTree::runs`]). 1 packs runs tightly.
+    pub run_align: u32,
 }
 
 impl Default for KdParams {
@@ -76,6 +80,7 @@ impl Default for KdParams {
             max_depth: None,
             depth_per_doubling: 1.3,
             binned_above: 4096,
+            run_align: 1,
         }
     }
 }
@@ -250,16 +255,55 @@ impl KdTree {
         )
     }
 
-    /// The primitives of a leaf node, which must be one of `self.nodes`.
+    /// A non-empty leaf node, which must be one of `self.nodes`, as the walk hands it out.
     #[inline]
-    fn leaf_prims<'a>(&'a self, leaf: &'a KdNode) -> &'a [u32] {
+    fn leaf<'a>(&'a self, leaf: &'a KdNode) -> Leaf<'a> {
         match leaf.prim_count() {
-            0 => &[],
-            1 => std::slice::from_ref(leaf.payload()),
+            0 => Leaf {
+                prims: &[],
+                run: None,
+            },
+            1 => Leaf {
+                prims: std::slice::from_ref(leaf.payload()),
+                run: None,
+            },
             n => {
                 let at = *leaf.payload() as usize;
-                &self.indices[at..at + n as usize]
+                Leaf {
+                    prims: &self.indices[at..at + n as usize],
+                    run: Some(at as u32),
+                }
             }
         }
     }
+
+    /// Every leaf of two or more primitives, as its run's offset in the index array and its
+    /// primitives; offsets are multiples of [`KdParams::run_align`].
+    pub fn runs(&self) -> impl Iterator<Item = (u32, &[u32])> + '_ {
+        self.nodes
+            .iter()
+            .filter(|n| n.is_leaf() && n.prim_count() > 1)
+            .map(|n| {
+                let at = *n.payload();
+                (
+                    at,
+                    &self.indices[at as usize..(at + n.prim_count()) as usize],
+                )
+            })
+    }
+
+    /// Length of the index array: data laid out beside it ([`KdTree::runs`]) needs this many
+    /// slots.
+    pub fn index_len(&self) -> usize {
+        self.indices.len()
+    }
+}
+
+/// A non-empty leaf as a walk hands it to the caller.
+#[derive(Clone, Copy, Debug)]
+pub struct Leaf<'a> {
+    pub prims: &'a [u32],
+    /// Where the leaf's run starts in the index array ([`KdTree::runs`]); `None` for a leaf
+    /// of one primitive, which the node holds itself.
+    pub run: Option<u32>,
 }

@@ -1,6 +1,6 @@
 //! Front-to-back traversal.
 
-use super::{KdTree, MAX_DEPTH};
+use super::{KdTree, Leaf, MAX_DEPTH};
 use crate::geometry::Ray;
 use glam::Vec3;
 
@@ -39,14 +39,33 @@ impl KdTree {
         t_max: f32,
         mut isect: impl FnMut(u32, f32) -> Option<f32>,
     ) -> Option<f32> {
-        let mut best = None;
-        self.walk(ray, t_max, |prims, t_far, mut limit| {
-            for &p in prims {
+        self.closest_hit_leaves(ray, t_max, |leaf, mut limit| {
+            let mut best = None;
+            for &p in leaf.prims {
                 // Re-check the contract so a careless callback cannot move the hit backwards.
                 if let Some(t) = isect(p, limit).filter(|&t| t < limit) {
                     limit = t;
                     best = Some(t);
                 }
+            }
+            best
+        })
+    }
+
+    /// Closest hit, a leaf at a time: `isect(leaf, t_max_now)` returns the closest hit among
+    /// the leaf's primitives with `0 < t < t_max_now`, if any. For callers that test a leaf's
+    /// primitives together (several at once, from data laid out along [`KdTree::runs`]).
+    pub fn closest_hit_leaves(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        mut isect: impl FnMut(Leaf<'_>, f32) -> Option<f32>,
+    ) -> Option<f32> {
+        let mut best = None;
+        self.walk(ray, t_max, |leaf, t_far, mut limit| {
+            if let Some(t) = isect(leaf, limit).filter(|&t| t < limit) {
+                limit = t;
+                best = Some(t);
             }
             // Hits are sorted by leaf, so one before this leaf's end beats all later leaves.
             if best.is_some() && limit < t_far {
@@ -66,9 +85,22 @@ impl KdTree {
         t_max: f32,
         mut occluded: impl FnMut(u32, f32) -> bool,
     ) -> bool {
+        self.any_hit_leaves(ray, t_max, |leaf, t_max| {
+            leaf.prims.iter().any(|&p| occluded(p, t_max))
+        })
+    }
+
+    /// Any hit before `t_max`, a leaf at a time: stops at the first leaf for which
+    /// `occluded(leaf, t_max)` returns true.
+    pub fn any_hit_leaves(
+        &self,
+        ray: &Ray,
+        t_max: f32,
+        mut occluded: impl FnMut(Leaf<'_>, f32) -> bool,
+    ) -> bool {
         let mut hit = false;
-        self.walk(ray, t_max, |prims, _, limit| {
-            if prims.iter().any(|&p| occluded(p, t_max)) {
+        self.walk(ray, t_max, |leaf, _, limit| {
+            if occluded(leaf, t_max) {
                 hit = true;
                 None
             } else {
@@ -81,7 +113,7 @@ impl KdTree {
     /// Visits the leaves the ray passes through, front to back. `leaf(prims, t_far, limit)`
     /// returns the new limit (pending subtrees starting beyond it are skipped), or `None` to stop.
     #[inline]
-    fn walk(&self, ray: &Ray, t_max: f32, leaf: impl FnMut(&[u32], f32, f32) -> Option<f32>) {
+    fn walk(&self, ray: &Ray, t_max: f32, leaf: impl FnMut(Leaf<'_>, f32, f32) -> Option<f32>) {
         // The stack is a local array, initialised on every call: sized to the tree's depth
         // rather than to the deepest possible tree, a shallow instance tree does not clear
         // 768 bytes per ray (that memset was 3 % of the instructions of a Cornell pass).
@@ -97,7 +129,7 @@ impl KdTree {
         &self,
         ray: &Ray,
         t_max: f32,
-        leaf: impl FnMut(&[u32], f32, f32) -> Option<f32>,
+        leaf: impl FnMut(Leaf<'_>, f32, f32) -> Option<f32>,
     ) {
         if self.nodes.is_empty() {
             return;
@@ -128,7 +160,7 @@ impl KdTree {
         mut t0: f32,
         mut t1: f32,
         t_max: f32,
-        mut leaf: impl FnMut(&[u32], f32, f32) -> Option<f32>,
+        mut leaf: impl FnMut(Leaf<'_>, f32, f32) -> Option<f32>,
     ) {
         // Per-axis values in arrays indexed by the node's axis bits: indexing a `Vec3` compiles
         // to a chain of compares on the axis, two more unpredictable branches per node.
@@ -202,7 +234,7 @@ impl KdTree {
             // Empty leaves (over half of a mesh tree's) need no call: a hit found earlier
             // that ends the walk is caught by the check on the next pending entry.
             if node.prim_count() != 0 {
-                match leaf(self.leaf_prims(node), t1, limit) {
+                match leaf(self.leaf(node), t1, limit) {
                     Some(l) => limit = l,
                     None => return,
                 }
