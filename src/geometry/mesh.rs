@@ -1296,6 +1296,74 @@ mod tests {
     }
 
     #[test]
+    fn block_screen_keeps_every_triangle_the_scalar_test_hits() {
+        use rand::{RngExt, SeedableRng};
+        // Triangles of a small grid, so that rays aimed at its vertices and edge midpoints
+        // make edge functions exactly zero, and random ones elsewhere; each block of four is
+        // screened and every lane checked against the scalar test.
+        let mut rng = rand_pcg::Pcg64::seed_from_u64(7);
+        let mut rnd = |lo: f32, hi: f32| lo + (hi - lo) * rng.random::<f32>();
+        let mut tris = Vec::new();
+        for i in 0..4 {
+            for j in 0..4 {
+                let p = |a: u32, b: u32| Vec3::new(a as f32, b as f32, 0.0);
+                tris.push([p(i, j), p(i + 1, j), p(i + 1, j + 1)]);
+                tris.push([p(i, j), p(i + 1, j + 1), p(i, j + 1)]);
+            }
+        }
+        while tris.len() < 64 {
+            let mut v = || Vec3::new(rnd(-1.0, 5.0), rnd(-1.0, 5.0), rnd(-2.0, 2.0));
+            tris.push([v(), v(), v()]);
+        }
+        let blocks: Vec<Tri4> = tris
+            .chunks(4)
+            .map(|four| {
+                let mut b = Tri4::default();
+                for (lane, t) in four.iter().enumerate() {
+                    for (j, v) in t.iter().enumerate() {
+                        for a in 0..3 {
+                            b.c[j][a][lane] = v[a];
+                        }
+                    }
+                }
+                b
+            })
+            .collect();
+        let (mut hits, mut rejected, mut lanes) = (0, 0, 0);
+        for k in 0..4000 {
+            let target = if k % 2 == 0 {
+                // A grid vertex or an edge midpoint.
+                let (a, b) = ((k / 2 % 9) as f32 * 0.5, (k / 18 % 9) as f32 * 0.5);
+                Vec3::new(a, b, 0.0)
+            } else {
+                Vec3::new(rnd(-1.0, 5.0), rnd(-1.0, 5.0), rnd(-1.0, 1.0))
+            };
+            let o = Vec3::new(rnd(-3.0, 7.0), rnd(-3.0, 7.0), rnd(-4.0, 4.0));
+            let ray = Ray::new(o, target - o);
+            let Some(frame) = RayFrame::new(&ray) else {
+                continue;
+            };
+            for (b, block) in blocks.iter().enumerate() {
+                let mask = frame.screen(block);
+                for lane in 0..4 {
+                    let tri = &tris[4 * b + lane];
+                    assert_eq!(block.corners(lane), *tri);
+                    let hit = frame.hit(tri, f32::INFINITY);
+                    lanes += 1;
+                    hits += usize::from(hit.is_some());
+                    if mask >> lane & 1 == 0 {
+                        rejected += 1;
+                        assert!(hit.is_none(), "{ray:?} lane {lane} of block {b}");
+                    }
+                }
+            }
+        }
+        // The screen must do its job too: it rejects most of the misses.
+        assert!(hits > 1000, "{hits} hits");
+        assert!(rejected > (lanes - hits) / 2, "{rejected} of {lanes}");
+    }
+
+    #[test]
     fn welding_and_closedness() {
         // A tetrahedron with one vertex duplicated (as a UV seam would do).
         let p = vec![
