@@ -943,6 +943,39 @@ mod tests {
     }
 
     #[test]
+    fn aligned_runs_change_only_the_offsets() {
+        // Parallel levels included: fragments appended to one another must keep alignment.
+        let boxes = random_boxes(20_000, 0.3, 23);
+        let leaves = |t: &KdTree| -> Vec<Vec<u32>> {
+            let mut v = Vec::new();
+            for i in 0..t.nodes.len() {
+                if t.nodes[i].is_leaf() {
+                    v.push(t.leaf(&t.nodes[i]).prims.to_vec());
+                }
+            }
+            v
+        };
+        let tight = KdTree::build(&boxes, &KdParams::default());
+        for align in [4, 8] {
+            let params = KdParams {
+                run_align: align,
+                ..KdParams::default()
+            };
+            let tree = KdTree::build(&boxes, &params);
+            assert_eq!(leaves(&tree), leaves(&tight));
+            assert_eq!(tree.index_len() % align as usize, 0);
+            let mut runs = 0;
+            for (at, prims) in tree.runs() {
+                assert_eq!(at % align, 0, "run at {at}");
+                assert!(prims.len() > 1);
+                runs += 1;
+            }
+            let multi = leaves(&tight).iter().filter(|l| l.len() > 1).count();
+            assert!(runs == multi && runs > 100, "{runs} runs, {multi} leaves");
+        }
+    }
+
+    #[test]
     fn binned_builds_cover_every_primitive() {
         let boxes = random_boxes(20_000, 0.3, 17);
         for binned_above in [8, 64, 4096] {

@@ -23,7 +23,9 @@
 //! **Layout** (as in pbrt). Nodes are 8 bytes in one depth-first array: an interior node holds
 //! the split position and, beside the axis in two low bits, the index of its above child; its
 //! below child is the next node. A leaf holds its primitive count and either its only primitive
-//! or an offset into the primitive index array.
+//! or an offset into the primitive index array. Those runs can be made to start at multiples
+//! of [`KdParams::run_align`], so that a caller may keep per-primitive data beside the index
+//! array in aligned blocks and test a leaf's primitives together ([`KdTree::closest_hit_leaves`]).
 //!
 //! **Traversal** clips the ray to the tree bounds, then walks front to back with a fixed stack
 //! of far children; a closest-hit query stops once its best hit lies before the current leaf's
