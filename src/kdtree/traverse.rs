@@ -125,8 +125,9 @@ impl KdTree {
         hit
     }
 
-    /// Visits the leaves the ray passes through, front to back. `leaf(prims, t_far, limit)`
-    /// returns the new limit (pending subtrees starting beyond it are skipped), or `None` to stop.
+    /// Visits the non-empty leaves the ray passes through, front to back.
+    /// `leaf(leaf, t_far, limit)` returns the new limit (pending subtrees starting beyond it are
+    /// skipped), or `None` to stop.
     #[inline]
     fn walk(&self, ray: &Ray, t_max: f32, leaf: impl FnMut(Leaf<'_>, f32, f32) -> Option<f32>) {
         // The stack is a local array, initialised on every call: sized to the tree's depth
@@ -452,6 +453,64 @@ mod tests {
         assert!(
             checked > 2500 && hits > checked / 4,
             "{checked} rays, {hits} hits"
+        );
+    }
+
+    #[test]
+    fn leaf_queries_match_brute_force() {
+        // Leaves handed out whole, with runs aligned to four as mesh trees have them (and
+        // several boxes to a leaf). Bars across the grid straddle split planes, so a leaf can
+        // report a hit beyond its own far end, before which a later leaf may hold a nearer one.
+        let mut boxes = grid_boxes();
+        for k in 0..8 {
+            let (y, z) = (k as f32 * 2.0 + 0.25, (7 - k) as f32 * 2.0 + 0.25);
+            boxes.push(Aabb::new(
+                Vec3::new(-1.0, y, z),
+                Vec3::new(16.0, y + 0.5, z + 0.5),
+            ));
+            boxes.push(Aabb::new(
+                Vec3::new(y, -1.0, z),
+                Vec3::new(y + 0.5, 16.0, z + 0.5),
+            ));
+        }
+        let params = KdParams {
+            run_align: 4,
+            max_leaf_prims: 8,
+            ..KdParams::default()
+        };
+        let tree = KdTree::build(&boxes, &params);
+        let (mut checked, mut hits, mut runs) = (0, 0, 0);
+        for i in 0..2000u32 {
+            let f = |k: u32| ((i.wrapping_mul(2_654_435_761) >> k) % 1000) as f32 / 1000.0;
+            let o = Vec3::new(f(0), f(3), f(7)) * 20.0 - Vec3::splat(2.0);
+            let d = Vec3::new(f(11), f(13), f(17)) - Vec3::splat(0.5);
+            let ray = Ray::new(o, d);
+            for t_max in [f32::INFINITY, 4.0] {
+                let want = brute(&boxes, &ray, t_max).map(|h| h.1);
+                let got = tree.closest_hit_leaves(&ray, t_max, |leaf, limit| {
+                    if let Some(at) = leaf.run {
+                        assert!(at % 4 == 0 && leaf.prims.len() > 1);
+                        runs += 1;
+                    }
+                    leaf.prims
+                        .iter()
+                        .filter_map(|&p| hit_box(&boxes[p as usize], &ray, limit))
+                        .min_by(f32::total_cmp)
+                });
+                assert_eq!(got, want, "{ray:?} t_max {t_max}");
+                let any = tree.any_hit_leaves(&ray, t_max, |leaf, tm| {
+                    leaf.prims
+                        .iter()
+                        .any(|&p| hit_box(&boxes[p as usize], &ray, tm).is_some())
+                });
+                assert_eq!(any, want.is_some(), "{ray:?} t_max {t_max}");
+                checked += 1;
+                hits += usize::from(want.is_some());
+            }
+        }
+        assert!(
+            hits > checked / 10 && runs > 0,
+            "{hits} of {checked}, {runs} runs"
         );
     }
 
