@@ -70,18 +70,25 @@ impl KdTree {
         mut isect: impl FnMut(Leaf<'_>, f32) -> Option<f32>,
     ) -> Option<f32> {
         let mut best = None;
-        self.walk(ray, t_max, |leaf, t_far, mut limit| {
-            if let Some(t) = isect(leaf, limit).filter(|&t| t < limit) {
-                limit = t;
-                best = Some(t);
-            }
-            // Hits are sorted by leaf, so one before this leaf's end beats all later leaves.
-            if best.is_some() && limit < t_far {
-                None
-            } else {
-                Some(limit)
-            }
-        });
+        // Inlined into the walk, so that the caller's leaf test is too (callgrind, box-crossing
+        // diffuse misses on the bunny: 0.5 % fewer instructions, 3 % fewer mispredictions).
+        self.walk(
+            ray,
+            t_max,
+            #[inline(always)]
+            |leaf, t_far, mut limit| {
+                if let Some(t) = isect(leaf, limit).filter(|&t| t < limit) {
+                    limit = t;
+                    best = Some(t);
+                }
+                // Hits are sorted by leaf, so one before this leaf's end beats all later leaves.
+                if best.is_some() && limit < t_far {
+                    None
+                } else {
+                    Some(limit)
+                }
+            },
+        );
         best
     }
 
