@@ -26,6 +26,18 @@ fn push<const N: usize>(stack: &mut [Todo; N], sp: &mut usize, node: usize, t0: 
     *sp += 1;
 }
 
+/// How a closest-hit walk goes on after a leaf: hits are sorted by leaf, so one found before
+/// this leaf's far end beats all later leaves and ends the walk; otherwise the limit is the
+/// best hit so far.
+#[inline(always)]
+fn after_leaf(found: bool, limit: f32, t_far: f32) -> Option<f32> {
+    if found && limit < t_far {
+        None
+    } else {
+        Some(limit)
+    }
+}
+
 impl KdTree {
     /// Closest hit. Calls `isect(prim, t_max_now)` for candidate primitives in front-to-back
     /// order; the callback returns `Some(t)` only for a hit with `0 < t < t_max_now` (the caller
@@ -50,12 +62,7 @@ impl KdTree {
                     best = Some(t);
                 }
             }
-            // Hits are sorted by leaf, so one before this leaf's end beats all later leaves.
-            if best.is_some() && limit < t_far {
-                None
-            } else {
-                Some(limit)
-            }
+            after_leaf(best.is_some(), limit, t_far)
         });
         best
     }
@@ -81,12 +88,7 @@ impl KdTree {
                     limit = t;
                     best = Some(t);
                 }
-                // Hits are sorted by leaf, so one before this leaf's end beats all later leaves.
-                if best.is_some() && limit < t_far {
-                    None
-                } else {
-                    Some(limit)
-                }
+                after_leaf(best.is_some(), limit, t_far)
             },
         );
         best
