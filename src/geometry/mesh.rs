@@ -809,6 +809,7 @@ pub struct MeshTree {
 /// Lanes per leaf block: [`KdParams::run_align`] of mesh trees.
 const LANES: u32 = 4;
 
+/// The tree and its blocks; runs are aligned to the blocks whatever `params.run_align` says.
 fn build_mesh_tree(tris: &[[Vec3; 3]], params: &KdParams) -> MeshTree {
     let params = KdParams {
         run_align: LANES,
