@@ -328,6 +328,50 @@ fn versus_obvhs(
             })
         });
     }
+
+    // The diffuse rays by what they do at the bunny: miss its box, cross the box without a
+    // hit, or hit. The kd walk and the BVH win and lose on different kinds.
+    let b = mesh.bounds();
+    let mut kinds: [(&str, Vec<Ray>); 3] = [
+        ("miss_box", vec![]),
+        ("cross_box_miss", vec![]),
+        ("hit", vec![]),
+    ];
+    for r in obj(bounce) {
+        let (t0, t1) = ((b.min - r.o) / r.d, (b.max - r.o) / r.d);
+        let enters = t0.min(t1).max_element().max(0.0) <= t0.max(t1).min_element();
+        let k = if !enters {
+            0
+        } else if mesh.intersect(&r, t_max).is_some() {
+            2
+        } else {
+            1
+        };
+        kinds[k].1.push(r);
+    }
+    for (kind, rays) in &kinds {
+        eprintln!("mesh_vs_obvhs/diffuse_{kind}: {} rays", rays.len());
+        g.bench_function(format!("closest_diffuse_{kind}_prism_kd"), |b| {
+            b.iter(|| {
+                rays.iter()
+                    .filter(|r| mesh.intersect(r, t_max).is_some())
+                    .count()
+            })
+        });
+        g.bench_function(format!("closest_diffuse_{kind}_obvhs_own_test"), |b| {
+            b.iter(|| {
+                rays.iter()
+                    .filter(|r| {
+                        let mut h = RayHit::none();
+                        bvh.ray_traverse(to_ob(r, t_max), &mut h, |ray, i| {
+                            ordered[i].intersect(ray)
+                        })
+                    })
+                    .count()
+            })
+        });
+    }
+
     g.finish();
 }
 
