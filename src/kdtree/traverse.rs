@@ -123,14 +123,20 @@ impl KdTree {
         mut occluded: impl FnMut(Leaf<'_>, f32) -> bool,
     ) -> bool {
         let mut hit = false;
-        self.walk(ray, t_max, |leaf, _, limit| {
-            if occluded(leaf, t_max) {
-                hit = true;
-                None
-            } else {
-                Some(limit)
-            }
-        });
+        // Inlined into the walk, as for `closest_hit_leaves`.
+        self.walk(
+            ray,
+            t_max,
+            #[inline(always)]
+            |leaf, _, limit| {
+                if occluded(leaf, t_max) {
+                    hit = true;
+                    None
+                } else {
+                    Some(limit)
+                }
+            },
+        );
         hit
     }
 
