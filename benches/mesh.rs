@@ -236,6 +236,20 @@ fn versus_obvhs(
     let obj = |rays: &[Ray]| -> Vec<Ray> { rays.iter().map(|r| placed.ray_to_object(r)).collect() };
     let to_ob = |r: &Ray, t: f32| obvhs::ray::Ray::new(r.o.into(), r.d.into(), 0.0, t);
 
+    // Closest hits found among the rays, by prism's tree and by obvhs's BVH with its own test.
+    let prism_closest = |rays: &[Ray]| {
+        rays.iter()
+            .filter(|r| mesh.intersect(r, t_max).is_some())
+            .count()
+    };
+    let obvhs_closest = |rays: &[Ray]| {
+        rays.iter()
+            .filter(|r| {
+                let mut h = RayHit::none();
+                bvh.ray_traverse(to_ob(r, t_max), &mut h, |ray, i| ordered[i].intersect(ray))
+            })
+            .count()
+    };
     let mut g = c.benchmark_group("mesh_vs_obvhs");
     for (name, rays) in [("primary", obj(primary)), ("diffuse", obj(bounce))] {
         let n = rays.len();
@@ -256,11 +270,7 @@ fn versus_obvhs(
         eprintln!("mesh_vs_obvhs/{name}: {n} rays, prism {hits} hits, obvhs {ob_hits} hits");
 
         g.bench_function(format!("closest_{name}_prism_kd"), |b| {
-            b.iter(|| {
-                rays.iter()
-                    .filter(|r| mesh.intersect(r, t_max).is_some())
-                    .count()
-            })
+            b.iter(|| prism_closest(&rays))
         });
         g.bench_function(format!("closest_{name}_prism_kd_exact_build"), |b| {
             b.iter(|| {
@@ -270,16 +280,7 @@ fn versus_obvhs(
             })
         });
         g.bench_function(format!("closest_{name}_obvhs_own_test"), |b| {
-            b.iter(|| {
-                rays.iter()
-                    .filter(|r| {
-                        let mut h = RayHit::none();
-                        bvh.ray_traverse(to_ob(r, t_max), &mut h, |ray, i| {
-                            ordered[i].intersect(ray)
-                        })
-                    })
-                    .count()
-            })
+            b.iter(|| obvhs_closest(&rays))
         });
         g.bench_function(format!("closest_{name}_obvhs_watertight"), |b| {
             b.iter(|| {
@@ -352,23 +353,10 @@ fn versus_obvhs(
     for (kind, rays) in &kinds {
         eprintln!("mesh_vs_obvhs/diffuse_{kind}: {} rays", rays.len());
         g.bench_function(format!("closest_diffuse_{kind}_prism_kd"), |b| {
-            b.iter(|| {
-                rays.iter()
-                    .filter(|r| mesh.intersect(r, t_max).is_some())
-                    .count()
-            })
+            b.iter(|| prism_closest(rays))
         });
         g.bench_function(format!("closest_diffuse_{kind}_obvhs_own_test"), |b| {
-            b.iter(|| {
-                rays.iter()
-                    .filter(|r| {
-                        let mut h = RayHit::none();
-                        bvh.ray_traverse(to_ob(r, t_max), &mut h, |ray, i| {
-                            ordered[i].intersect(ray)
-                        })
-                    })
-                    .count()
-            })
+            b.iter(|| obvhs_closest(rays))
         });
     }
 
