@@ -47,6 +47,12 @@ impl KdNode {
         self.flags & 3 == LEAF
     }
 
+    /// A leaf without primitives.
+    #[inline]
+    pub fn is_empty_leaf(&self) -> bool {
+        self.flags == LEAF
+    }
+
     #[inline]
     pub fn axis(&self) -> usize {
         (self.flags & 3) as usize

