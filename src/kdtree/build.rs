@@ -9,7 +9,7 @@ use super::node::KdNode;
 use super::{KdParams, KdPrimitives, KdStats, MAX_DEPTH};
 
 use crate::geometry::Aabb;
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 
 const AXIS_SHIFT: u32 = 62;
 const POS_SHIFT: u32 = 30;
@@ -202,10 +202,10 @@ const BINS: usize = 32;
 /// boundary may land one bin low, which only makes its reference count on both sides of that
 /// plane.
 #[inline]
-fn bins(x: Vec3) -> [usize; 3] {
+fn bins(x: Vec3A) -> [usize; 3] {
     const { assert!(BINS.is_power_of_two() && BINS <= 1 << 20) };
-    let v = x.clamp(Vec3::ZERO, Vec3::splat(BINS as f32 - 0.25)) - Vec3::splat(0.5)
-        + Vec3::splat(12_582_912.0);
+    let v = x.clamp(Vec3A::ZERO, Vec3A::splat(BINS as f32 - 0.25)) - Vec3A::splat(0.5)
+        + Vec3A::splat(12_582_912.0);
     v.to_array()
         .map(|f| (f.to_bits() & (BINS as u32 - 1)) as usize)
 }
@@ -524,16 +524,24 @@ impl<P: KdPrimitives + ?Sized> Ctx<'_, P> {
         );
         let mut starts = [[0u32; BINS]; 3];
         let mut ends = [[0u32; BINS]; 3];
-        let mut span = Aabb::EMPTY;
+        // In SIMD registers: as `Vec3` each step is three scalar ones.
+        let (scale, origin) = (Vec3A::from(scale), Vec3A::from(cell.min));
+        let (mut span_lo, mut span_hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
         for r in refs {
-            let s = bins((r.b.min - cell.min) * scale);
-            let e = bins((r.b.max - cell.min) * scale);
+            let (lo, hi) = (Vec3A::from(r.b.min), Vec3A::from(r.b.max));
+            let s = bins((lo - origin) * scale);
+            let e = bins((hi - origin) * scale);
             for a in 0..3 {
                 starts[a][s[a]] += 1;
                 ends[a][e[a]] += 1;
             }
-            span = span.union(&r.b);
+            span_lo = span_lo.min(lo);
+            span_hi = span_hi.max(hi);
         }
+        let span = Aabb {
+            min: span_lo.into(),
+            max: span_hi.into(),
+        };
         let mut best = Cheapest(None);
         for axis in 0..3 {
             let ac = AxisCell::new(cell, axis, 1.0 / sa);
@@ -867,7 +875,7 @@ mod tests {
         for _ in 0..100_000 {
             let x = r.f() * 40.0 - 4.0;
             let want = x.floor().clamp(0.0, (BINS - 1) as f32) as usize;
-            let got = bins(Vec3::splat(x))[0];
+            let got = bins(Vec3A::splat(x))[0];
             // Exactly on a boundary the bin below is allowed.
             let on_boundary = x == x.floor() && x > 0.0 && x < BINS as f32;
             assert!(
@@ -875,8 +883,8 @@ mod tests {
                 "{x}: bin {got}, floor {want}"
             );
         }
-        assert_eq!(bins(Vec3::new(0.0, 31.999, 1e30)), [0, 31, 31]);
-        assert_eq!(bins(Vec3::new(-1e30, 0.49, 30.5)), [0, 0, 30]);
+        assert_eq!(bins(Vec3A::new(0.0, 31.999, 1e30)), [0, 31, 31]);
+        assert_eq!(bins(Vec3A::new(-1e30, 0.49, 30.5)), [0, 0, 30]);
     }
 
     #[test]
