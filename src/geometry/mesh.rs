@@ -1053,28 +1053,50 @@ fn split_triangle(tri: &[Vec3; 3], node: &Aabb, axis: usize, pos: f32) -> (Aabb,
             clip_triangle(tri, &child(true)),
         );
     };
-    let mut out = [DVec3::ZERO; CLIP_CAP];
-    let mut side = |bound: f32, keep_above: bool| match clip_polygon(
-        &poly[..n],
-        &mut out,
-        axis,
-        f64::from(bound),
-        keep_above,
-    ) {
-        Some(0) => Aabb::EMPTY,
-        Some(m) => {
-            let mut b = Aabb::EMPTY;
-            for p in &out[..m] {
-                b = b.union_point(p.as_vec3());
-            }
+    let (below, above) =
+        split_polygon_bounds(&poly[..n], axis, f64::from(pos + pad), f64::from(pos - pad));
+    let grow = |b: Aabb| {
+        if b.is_empty() {
+            Aabb::EMPTY
+        } else {
             Aabb {
                 min: b.min - pad,
                 max: b.max + pad,
             }
         }
-        None => clip_triangle(tri, &child(keep_above)),
     };
-    (side(pos + pad, false), side(pos - pad, true))
+    (grow(below), grow(above))
+}
+
+/// The bounds of the parts of a polygon with `x[axis] <= below` and with `x[axis] >= above`:
+/// the boxes of what two Sutherland–Hodgman steps ([`clip_polygon`]) would keep, the same
+/// points computed the same way, in one pass and without building either polygon.
+fn split_polygon_bounds(poly: &[DVec3], axis: usize, below: f64, above: f64) -> (Aabb, Aabb) {
+    let (mut lo, mut hi) = (Aabb::EMPTY, Aabb::EMPTY);
+    let cross = |cur: DVec3, next: DVec3, bound: f64| {
+        let s = (bound - cur[axis]) / (next[axis] - cur[axis]);
+        let mut x = cur + (next - cur) * s;
+        x[axis] = bound;
+        x.as_vec3()
+    };
+    for k in 0..poly.len() {
+        let cur = poly[k];
+        let next = poly[(k + 1) % poly.len()];
+        let (c, n) = (cur[axis], next[axis]);
+        if c <= below {
+            lo = lo.union_point(cur.as_vec3());
+        }
+        if (c <= below) != (n <= below) {
+            lo = lo.union_point(cross(cur, next, below));
+        }
+        if c >= above {
+            hi = hi.union_point(cur.as_vec3());
+        }
+        if (c >= above) != (n >= above) {
+            hi = hi.union_point(cross(cur, next, above));
+        }
+    }
+    (lo, hi)
 }
 
 /// Clips a triangle (with box `full`) to `cell` in f64 into `poly`: the vertex count, or
