@@ -9,7 +9,7 @@ use super::node::KdNode;
 use super::{KdParams, KdPrimitives, KdStats, MAX_DEPTH};
 
 use crate::geometry::Aabb;
-use glam::{Vec3, Vec3A};
+use glam::{Vec3, Vec3A, Vec4};
 
 const AXIS_SHIFT: u32 = 62;
 const POS_SHIFT: u32 = 30;
@@ -192,6 +192,17 @@ const RIGHT: u8 = 2;
 
 /// Bins per axis of the binned SAH.
 const BINS: usize = 32;
+
+/// Where the planes between bins lie, as fractions of the cell (plane k at k / BINS).
+const PLANE_AT: [f32; BINS] = {
+    let mut a = [0.0; BINS];
+    let mut k = 0;
+    while k < BINS {
+        a[k] = k as f32 / BINS as f32;
+        k += 1;
+    }
+    a
+};
 
 /// The bins of offsets measured in bin widths, clamped to the bins: ⌊x⌋ in [0, BINS − 1].
 ///
@@ -562,23 +573,56 @@ impl<P: KdPrimitives + ?Sized> Ctx<'_, P> {
                 let (l, r) = if planar_left { (n, 0) } else { (0, n) };
                 best.offer(axis, pos, planar_left, self.cost(pl, pr, l, r, wl, wr));
             }
-            let (mut nl, mut nr) = (0u32, n);
-            let used = |k: usize| starts[k] | ends[k] != 0;
+            // Every plane between bins, priced four at a time: the same arithmetic as
+            // `AxisCell::sides` and `cost`, lane for lane.
+            let (mut nl, mut nr) = ([0.0f32; BINS], [0.0f32; BINS]);
+            let (mut l, mut r) = (0u32, n);
             for k in 1..BINS {
-                nl += starts[k - 1];
-                nr -= ends[k - 1];
-                // Between bins where no face falls the counts stay the same and the cost is
-                // linear in the position, so its minimum over such a run of planes is at one
-                // of the run's ends: only those are priced (most bins of a small node are empty).
-                if !(k == 1 || k == BINS - 1 || used(k - 1) || used(k)) {
-                    continue;
-                }
-                let pos = lo + (hi - lo) * (k as f32 / BINS as f32);
-                if pos <= lo || pos >= hi {
-                    continue;
-                }
-                let (wl, wr, pl, pr) = ac.sides(pos);
-                best.offer(axis, pos, true, self.cost(pl, pr, nl, nr, wl, wr));
+                l += starts[k - 1];
+                r -= ends[k - 1];
+                nl[k] = l as f32;
+                nr[k] = r as f32;
+            }
+            let (lo4, hi4, width) = (Vec4::splat(lo), Vec4::splat(hi), Vec4::splat(hi - lo));
+            let (cap, rim, inv_sa) = (
+                Vec4::splat(ac.cap),
+                Vec4::splat(ac.rim),
+                Vec4::splat(ac.inv_sa),
+            );
+            let two = Vec4::splat(2.0);
+            let bonus = Vec4::splat(1.0 - self.empty_bonus);
+            let mut costs = [Vec4::INFINITY; BINS / 4];
+            let mut least = Vec4::INFINITY;
+            for (g, c) in costs.iter_mut().enumerate() {
+                let at = |a: &[f32; BINS]| Vec4::from_slice(&a[4 * g..4 * g + 4]);
+                let (nl, nr) = (at(&nl), at(&nr));
+                let pos = lo4 + width * Vec4::from_slice(&PLANE_AT[4 * g..4 * g + 4]);
+                let (wl, wr) = (pos - lo4, hi4 - pos);
+                let pl = two * (cap + wl * rim) * inv_sa;
+                let pr = two * (cap + wr * rim) * inv_sa;
+                let empty = (nl.cmpeq(Vec4::ZERO) & wl.cmpgt(Vec4::ZERO))
+                    | (nr.cmpeq(Vec4::ZERO) & wr.cmpgt(Vec4::ZERO));
+                let scale = Vec4::select(empty, bonus, Vec4::ONE);
+                let cost = Vec4::splat(self.traversal_cost)
+                    + Vec4::splat(self.intersect_cost) * scale * (pl * nl + pr * nr);
+                // Plane 0 is the cell's face, and rounding may put others on a face too.
+                let inside = pos.cmpgt(lo4) & pos.cmplt(hi4);
+                *c = Vec4::select(inside, cost, Vec4::INFINITY);
+                least = least.min(*c);
+            }
+            let least = least.min_element();
+            if least < f32::INFINITY {
+                // The first plane at the least cost, as offering them in order would keep.
+                let k = costs
+                    .iter()
+                    .enumerate()
+                    .find_map(|(g, c)| {
+                        let m = c.cmpeq(Vec4::splat(least)).bitmask();
+                        (m != 0).then(|| 4 * g + m.trailing_zeros() as usize)
+                    })
+                    .unwrap_or(0);
+                let pos = lo + (hi - lo) * PLANE_AT[k];
+                best.offer(axis, pos, true, least);
             }
         }
         best.0
