@@ -9,7 +9,7 @@ use super::node::KdNode;
 use super::{KdParams, KdPrimitives, KdStats, MAX_DEPTH};
 
 use crate::geometry::Aabb;
-use glam::{Vec3, Vec3A, Vec4};
+use glam::{Vec3, Vec4};
 
 const AXIS_SHIFT: u32 = 62;
 const POS_SHIFT: u32 = 30;
@@ -213,12 +213,12 @@ const PLANE_AT: [f32; BINS] = {
 /// boundary may land one bin low, which only makes its reference count on both sides of that
 /// plane.
 #[inline]
-fn bins(x: Vec3A) -> [usize; 3] {
+fn bins(x: Vec4) -> [usize; 3] {
     const { assert!(BINS.is_power_of_two() && BINS <= 1 << 20) };
-    let v = x.clamp(Vec3A::ZERO, Vec3A::splat(BINS as f32 - 0.25)) - Vec3A::splat(0.5)
-        + Vec3A::splat(12_582_912.0);
-    v.to_array()
-        .map(|f| (f.to_bits() & (BINS as u32 - 1)) as usize)
+    let v = x.clamp(Vec4::ZERO, Vec4::splat(BINS as f32 - 0.25)) - Vec4::splat(0.5)
+        + Vec4::splat(12_582_912.0);
+    let [x, y, z, _] = v.to_array();
+    [x, y, z].map(|f| (f.to_bits() & (BINS as u32 - 1)) as usize)
 }
 
 /// Nodes with at least this many references build their two children in parallel. Fixed, so
@@ -301,11 +301,40 @@ impl Pool {
 /// Nodes of at most this many references have every box face priced exactly.
 const FEW: usize = 6;
 
-/// A primitive's part inside a node: its index and the bounds of that part.
+/// A primitive's part inside a node: the bounds of that part in SIMD registers' layout (the
+/// binning reads every reference at every level), the primitive's index in the spare lane.
 #[derive(Clone, Copy)]
 struct Ref {
-    b: Aabb,
-    prim: u32,
+    lo: Vec4,
+    hi: Vec4,
+}
+
+/// Set in the spare lane's bits so that it always holds a normal float, whatever the index:
+/// the lane goes through the binning arithmetic, where a denormal may be slow.
+const PRIM_TAG: u32 = 0x4000_0000;
+
+impl Ref {
+    #[inline]
+    fn new(b: &Aabb, prim: u32) -> Self {
+        const { assert!(PRIM_BITS <= 28) };
+        Self {
+            lo: b.min.extend(f32::from_bits(PRIM_TAG | prim)),
+            hi: b.max.extend(0.0),
+        }
+    }
+
+    #[inline]
+    fn prim(&self) -> u32 {
+        self.lo.w.to_bits() & !PRIM_TAG
+    }
+
+    #[inline]
+    fn bounds(&self) -> Aabb {
+        Aabb {
+            min: self.lo.truncate(),
+            max: self.hi.truncate(),
+        }
+    }
 }
 
 /// The cost model and limits, shared by every task of a build.
@@ -336,7 +365,7 @@ pub(crate) fn build<P: KdPrimitives + ?Sized>(prims: &P, params: &KdParams) -> B
             continue;
         }
         bounds = bounds.union(&b);
-        refs.push(Ref { b, prim: i });
+        refs.push(Ref::new(&b, i));
     }
     let kept = refs.len();
 
@@ -421,7 +450,7 @@ impl<P: KdPrimitives + ?Sized> Ctx<'_, P> {
             self.binned_split(&refs, &cell, n as u32)
         };
         let Some(split) = split.filter(|s| s.cost < self.intersect_cost * n as f32) else {
-            let mut prims: Vec<u32> = refs.iter().map(|r| r.prim).collect();
+            let mut prims: Vec<u32> = refs.iter().map(Ref::prim).collect();
             out.leaf(&mut prims, depth, self.run_align);
             pool.put(refs);
             return;
@@ -486,13 +515,13 @@ impl<P: KdPrimitives + ?Sized> Ctx<'_, P> {
                 continue;
             }
             for c in refs {
-                for pos in [c.b.min[axis], c.b.max[axis]] {
+                for pos in [c.lo[axis], c.hi[axis]] {
                     if pos < ac.lo || pos > ac.hi {
                         continue;
                     }
                     let (mut l, mut r, mut planar) = (0u32, 0u32, 0u32);
                     for x in refs {
-                        let (a, b) = (x.b.min[axis], x.b.max[axis]);
+                        let (a, b) = (x.lo[axis], x.hi[axis]);
                         if a == pos && b == pos {
                             planar += 1;
                         } else {
@@ -536,10 +565,10 @@ impl<P: KdPrimitives + ?Sized> Ctx<'_, P> {
         let mut starts = [[0u32; BINS]; 3];
         let mut ends = [[0u32; BINS]; 3];
         // In SIMD registers: as `Vec3` each step is three scalar ones.
-        let (scale, origin) = (Vec3A::from(scale), Vec3A::from(cell.min));
-        let (mut span_lo, mut span_hi) = (Vec3A::INFINITY, Vec3A::NEG_INFINITY);
+        let (scale, origin) = (scale.extend(0.0), cell.min.extend(0.0));
+        let (mut span_lo, mut span_hi) = (Vec4::INFINITY, Vec4::NEG_INFINITY);
         for r in refs {
-            let (lo, hi) = (Vec3A::from(r.b.min), Vec3A::from(r.b.max));
+            let (lo, hi) = (r.lo, r.hi);
             let s = bins((lo - origin) * scale);
             let e = bins((hi - origin) * scale);
             for a in 0..3 {
@@ -550,8 +579,8 @@ impl<P: KdPrimitives + ?Sized> Ctx<'_, P> {
             span_hi = span_hi.max(hi);
         }
         let span = Aabb {
-            min: span_lo.into(),
-            max: span_hi.into(),
+            min: span_lo.truncate(),
+            max: span_hi.truncate(),
         };
         let mut best = Cheapest(None);
         for axis in 0..3 {
@@ -641,24 +670,18 @@ impl<P: KdPrimitives + ?Sized> Ctx<'_, P> {
         let mut left = pool.take();
         let mut right = pool.take();
         for r in refs {
-            let (lo, hi) = (r.b.min[a], r.b.max[a]);
+            let (lo, hi) = (r.lo[a], r.hi[a]);
             if hi <= pos && (lo < pos || split.planar_left) {
                 left.push(*r);
             } else if lo >= pos {
                 right.push(*r);
             } else {
-                let (bl, br) = self.clip_both(r.prim, split, below, above);
+                let (bl, br) = self.clip_both(r.prim(), split, below, above);
                 if !bl.is_empty() {
-                    left.push(Ref {
-                        b: bl,
-                        prim: r.prim,
-                    });
+                    left.push(Ref::new(&bl, r.prim()));
                 }
                 if !br.is_empty() {
-                    right.push(Ref {
-                        b: br,
-                        prim: r.prim,
-                    });
+                    right.push(Ref::new(&br, r.prim()));
                 }
             }
         }
@@ -670,12 +693,12 @@ impl<P: KdPrimitives + ?Sized> Ctx<'_, P> {
     fn exact(&self, refs: &[Ref], cell: Aabb, depth: u32, out: &mut Frag) {
         let mut events = Vec::with_capacity(6 * refs.len());
         for (k, r) in refs.iter().enumerate() {
-            push_events(&mut events, k as u32, &r.b);
+            push_events(&mut events, k as u32, &r.bounds());
         }
         events.sort_unstable();
         let mut b = Exact {
             ctx: self,
-            ids: refs.iter().map(|r| r.prim).collect(),
+            ids: refs.iter().map(Ref::prim).collect(),
             side: vec![BOTH; refs.len()],
             scratch: Vec::new(),
             out,
@@ -919,7 +942,7 @@ mod tests {
         for _ in 0..100_000 {
             let x = r.f() * 40.0 - 4.0;
             let want = x.floor().clamp(0.0, (BINS - 1) as f32) as usize;
-            let got = bins(Vec3A::splat(x))[0];
+            let got = bins(Vec4::splat(x))[0];
             // Exactly on a boundary the bin below is allowed.
             let on_boundary = x == x.floor() && x > 0.0 && x < BINS as f32;
             assert!(
@@ -927,8 +950,8 @@ mod tests {
                 "{x}: bin {got}, floor {want}"
             );
         }
-        assert_eq!(bins(Vec3A::new(0.0, 31.999, 1e30)), [0, 31, 31]);
-        assert_eq!(bins(Vec3A::new(-1e30, 0.49, 30.5)), [0, 0, 30]);
+        assert_eq!(bins(Vec4::new(0.0, 31.999, 1e30, 0.0)), [0, 31, 31]);
+        assert_eq!(bins(Vec4::new(-1e30, 0.49, 30.5, 0.0)), [0, 0, 30]);
     }
 
     #[test]
