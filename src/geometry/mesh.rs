@@ -1046,15 +1046,20 @@ fn split_triangle(tri: &[Vec3; 3], node: &Aabb, axis: usize, pos: f32) -> (Aabb,
         min: node.min - pad,
         max: node.max + pad,
     };
-    let mut poly = [DVec3::ZERO; CLIP_CAP];
-    let Some(n) = clip_to_cell(tri, &full, &cell, &mut poly) else {
-        return (
-            clip_triangle(tri, &child(false)),
-            clip_triangle(tri, &child(true)),
-        );
+    let (lo, hi) = (f64::from(pos + pad), f64::from(pos - pad));
+    let (below, above) = if full.min.cmpge(cell.min).all() && full.max.cmple(cell.max).all() {
+        // Most straddlers lie inside the node but for the plane: the triangle is the polygon.
+        split_polygon_bounds(&tri.map(Vec3::as_dvec3), axis, lo, hi)
+    } else {
+        let mut poly = [DVec3::ZERO; CLIP_CAP];
+        let Some(n) = clip_to_cell(tri, &full, &cell, &mut poly) else {
+            return (
+                clip_triangle(tri, &child(false)),
+                clip_triangle(tri, &child(true)),
+            );
+        };
+        split_polygon_bounds(&poly[..n], axis, lo, hi)
     };
-    let (below, above) =
-        split_polygon_bounds(&poly[..n], axis, f64::from(pos + pad), f64::from(pos - pad));
     let grow = |b: Aabb| {
         if b.is_empty() {
             Aabb::EMPTY
