@@ -669,11 +669,18 @@ impl<P: KdPrimitives + ?Sized> Ctx<'_, P> {
         let (a, pos) = (split.axis, split.pos);
         let mut left = pool.take();
         let mut right = pool.take();
+        // Either side holds at most every reference: no growth, no copies on the way.
+        left.reserve(refs.len());
+        right.reserve(refs.len());
+        // The axis's lane picked from whole-register compares: indexing a lane by the axis
+        // compiled to a branch on the axis for every reference.
+        let (bit, at) = (1 << a, Vec4::splat(pos));
         for r in refs {
-            let (lo, hi) = (r.lo[a], r.hi[a]);
-            if hi <= pos && (lo < pos || split.planar_left) {
+            let hi_le = r.hi.cmple(at).bitmask() & bit != 0;
+            let lo_lt = r.lo.cmplt(at).bitmask() & bit != 0;
+            if hi_le && (lo_lt || split.planar_left) {
                 left.push(*r);
-            } else if lo >= pos {
+            } else if !lo_lt {
                 right.push(*r);
             } else {
                 let (bl, br) = self.clip_both(r.prim(), split, below, above);
