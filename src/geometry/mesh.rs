@@ -516,15 +516,14 @@ impl TriangleMesh {
     /// Closest hit with `t` in (0, t_max).
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<MeshHit> {
-        if !RayFrame::accepts(ray) {
-            return None;
-        }
         // Built at the first triangle: most rays that reach a mesh's box in a scene miss the
         // mesh without testing one, and the frame's setup branches on the ray's direction.
+        // The walk itself never starts for a non-finite ray, so the frame's own check of the
+        // ray (a zero direction) is left to that point too.
         let mut frame = None;
         let mut best = None;
         self.tree.closest_hit_leaves(ray, t_max, |leaf, mut limit| {
-            let frame = frame.get_or_insert_with(|| RayFrame::build(ray));
+            let frame = frame.get_or_insert_with(|| RayFrame::new(ray)).as_ref()?;
             let mut found = None;
             self.leaf_candidates(frame, leaf, |i, tri| {
                 if let Some((t, b1, b2)) = frame.hit(tri, limit) {
@@ -542,12 +541,11 @@ impl TriangleMesh {
     /// Whether anything lies on the ray with `t` in (0, t_max).
     #[inline]
     pub fn occluded(&self, ray: &Ray, t_max: f32) -> bool {
-        if !RayFrame::accepts(ray) {
-            return false;
-        }
         let mut frame = None;
         self.tree.any_hit_leaves(ray, t_max, |leaf, limit| {
-            let frame = frame.get_or_insert_with(|| RayFrame::build(ray));
+            let Some(frame) = frame.get_or_insert_with(|| RayFrame::new(ray)) else {
+                return false;
+            };
             self.leaf_candidates(frame, leaf, |_, tri| frame.hit(tri, limit).is_some())
         })
     }
@@ -1400,6 +1398,31 @@ mod tests {
         // The screen must do its job too: it rejects most of the misses.
         assert!(hits > 1000, "{hits} hits");
         assert!(rejected > (lanes - hits) / 2, "{rejected} of {lanes}");
+    }
+
+    #[test]
+    fn degenerate_rays_meet_nothing() {
+        let (p, f) = icosphere(2);
+        let mesh = TriangleMesh::new(p, f, None, None).unwrap();
+        let inside = Vec3::new(0.1, 0.2, 0.05);
+        // The same origin with a good direction hits the sphere around it.
+        assert!(
+            mesh.intersect(&Ray::new(inside, Vec3::X), f32::INFINITY)
+                .is_some()
+        );
+        let nan = f32::NAN;
+        for ray in [
+            Ray::new(inside, Vec3::ZERO),
+            Ray::new(inside, Vec3::new(nan, 0.0, 1.0)),
+            Ray::new(inside, Vec3::new(f32::INFINITY, 1.0, 1.0)),
+            Ray::new(Vec3::new(nan, 0.0, 0.0), Vec3::X),
+            Ray::new(Vec3::new(f32::NEG_INFINITY, 0.0, 0.0), Vec3::X),
+            // Axis-parallel, with a non-finite origin: the general walk's path.
+            Ray::new(Vec3::new(0.0, nan, 0.0), Vec3::X),
+        ] {
+            assert!(mesh.intersect(&ray, f32::INFINITY).is_none(), "{ray:?}");
+            assert!(!mesh.occluded(&ray, f32::INFINITY), "{ray:?}");
+        }
     }
 
     #[test]

@@ -2,7 +2,7 @@
 
 use super::{KdTree, Leaf, MAX_DEPTH};
 use crate::geometry::Ray;
-use glam::Vec3;
+use glam::{Vec3, Vec3A};
 
 /// A far child still to visit, with the ray's parametric range inside it.
 #[derive(Clone, Copy)]
@@ -165,12 +165,19 @@ impl KdTree {
         if self.nodes.is_empty() {
             return;
         }
-        // 1/±0 = ±inf: axis-parallel rays get infinite plane distances.
-        let inv_d = Vec3::ONE / ray.d;
-        if inv_d.is_finite() && ray.d.is_finite() && ray.o.is_finite() {
-            if let Some((t0, t1)) = self.bounds.intersect_oblique(ray, inv_d, t_max) {
-                self.walk_from::<N, true>(ray, inv_d, t0, t1, t_max, leaf);
+        // 1/±0 = ±inf: axis-parallel rays get infinite plane distances. The checks and the
+        // box test run in SIMD registers: most rays that reach a mesh's tree miss its box.
+        let (o, d) = (Vec3A::from(ray.o), Vec3A::from(ray.d));
+        let inv = Vec3A::ONE / d;
+        if (inv.is_finite_mask() & d.is_finite_mask() & o.is_finite_mask()).all() {
+            if let Some((t0, t1)) = self.bounds.intersect_oblique(o, inv, t_max) {
+                self.walk_from::<N, true>(ray, inv.into(), t0, t1, t_max, leaf);
             }
+            return;
+        }
+        let inv_d = Vec3::from(inv);
+        if !(ray.d.is_finite() && ray.o.is_finite()) {
+            // A ray with a non-finite origin or direction meets nothing.
         } else if let Some((t0, t1)) = self.bounds.intersect_p(ray, inv_d, t_max) {
             self.walk_from::<N, false>(ray, inv_d, t0, t1, t_max, leaf);
         }
