@@ -125,8 +125,8 @@ impl Aabb {
     /// [`Aabb::intersect_p`] for a ray whose origin and `inv_d` are finite (no direction
     /// component is zero), so that no slab distance is NaN: the same range, computed without
     /// branches, which matters for the many incoherent rays that miss a mesh's box.
-    #[inline]
     /// Takes the origin and `inv_d` in SIMD registers (`Vec3A`): as `Vec3` each step is three.
+    #[inline]
     pub fn intersect_oblique(&self, o: Vec3A, inv_d: Vec3A, t_max: f32) -> Option<(f32, f32)> {
         let a = (Vec3A::from(self.min) - o) * inv_d;
         let b = (Vec3A::from(self.max) - o) * inv_d;
