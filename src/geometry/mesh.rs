@@ -853,16 +853,11 @@ impl RayFrame {
     /// `None` for a ray with a zero or non-finite direction or a non-finite origin.
     #[inline]
     pub fn new(ray: &Ray) -> Option<Self> {
-        Self::accepts(ray).then(|| Self::build(ray))
+        let usable = ray.d.is_finite() && ray.o.is_finite() && ray.d != Vec3::ZERO;
+        usable.then(|| Self::build(ray))
     }
 
-    /// Whether [`RayFrame::new`] gives a frame for this ray.
-    #[inline]
-    pub fn accepts(ray: &Ray) -> bool {
-        ray.d.is_finite() && ray.o.is_finite() && ray.d != Vec3::ZERO
-    }
-
-    /// The frame of a ray that [`RayFrame::accepts`].
+    /// The frame of a ray that [`RayFrame::new`] accepts.
     #[inline]
     fn build(ray: &Ray) -> Self {
         let d = ray.d.to_array();

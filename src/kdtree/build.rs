@@ -640,18 +640,14 @@ impl<P: KdPrimitives + ?Sized> Ctx<'_, P> {
                 least = least.min(*c);
             }
             let least = least.min_element();
-            if least < f32::INFINITY {
-                // The first plane at the least cost, as offering them in order would keep.
-                let k = costs
-                    .iter()
-                    .enumerate()
-                    .find_map(|(g, c)| {
-                        let m = c.cmpeq(Vec4::splat(least)).bitmask();
-                        (m != 0).then(|| 4 * g + m.trailing_zeros() as usize)
-                    })
-                    .unwrap_or(0);
-                let pos = lo + (hi - lo) * PLANE_AT[k];
-                best.offer(axis, pos, true, least);
+            // The first plane at the least cost, as offering them in order would keep; none
+            // when every plane is priced out (all infinite).
+            let first = costs.iter().enumerate().find_map(|(g, c)| {
+                let m = c.cmpeq(Vec4::splat(least)).bitmask();
+                (least < f32::INFINITY && m != 0).then(|| 4 * g + m.trailing_zeros() as usize)
+            });
+            if let Some(k) = first {
+                best.offer(axis, lo + (hi - lo) * PLANE_AT[k], true, least);
             }
         }
         best.0

@@ -175,10 +175,12 @@ impl KdTree {
             }
             return;
         }
-        let inv_d = Vec3::from(inv);
+        // A ray with a non-finite origin or direction meets nothing.
         if !(ray.d.is_finite() && ray.o.is_finite()) {
-            // A ray with a non-finite origin or direction meets nothing.
-        } else if let Some((t0, t1)) = self.bounds.intersect_p(ray, inv_d, t_max) {
+            return;
+        }
+        let inv_d = Vec3::from(inv);
+        if let Some((t0, t1)) = self.bounds.intersect_p(ray, inv_d, t_max) {
             self.walk_from::<N, false>(ray, inv_d, t0, t1, t_max, leaf);
         }
     }
