@@ -87,6 +87,21 @@ impl KdNode {
         }
     }
 
+    /// The node as one word (payload low, flags high), for selects between whole nodes.
+    #[inline(always)]
+    pub fn bits(self) -> u64 {
+        u64::from(self.payload) | u64::from(self.flags) << 32
+    }
+
+    /// The node of [`KdNode::bits`].
+    #[inline(always)]
+    pub fn from_bits(b: u64) -> Self {
+        Self {
+            payload: b as u32,
+            flags: (b >> 32) as u32,
+        }
+    }
+
     /// Payload and flags, for exact comparisons of trees.
     pub fn words(&self) -> [u32; 2] {
         [self.payload, self.flags]
@@ -142,6 +157,18 @@ mod tests {
                 assert_eq!(*n.payload(), first);
             }
         }
+    }
+
+    #[test]
+    fn bits_round_trip() {
+        for n in [
+            KdNode::interior(2, -1.5, 77),
+            KdNode::leaf(0, 0),
+            KdNode::leaf(9, 1234),
+        ] {
+            assert_eq!(KdNode::from_bits(n.bits()), n);
+        }
+        assert!(KdNode::from_bits(KdNode::leaf(0, 5).bits()).is_empty_leaf());
     }
 
     #[test]
