@@ -220,6 +220,18 @@ fn versus_obvhs(
         },
     )
     .unwrap();
+    // The same tree walked with selects instead of branches (`KdParams::select_walk`).
+    let selects = TriangleMesh::with_params(
+        mesh.positions().to_vec(),
+        mesh.indices().to_vec(),
+        Some(mesh.normals().to_vec()),
+        mesh.uvs().map(<[Vec2]>::to_vec),
+        &KdParams {
+            select_walk: true,
+            ..TriangleMesh::kd_params()
+        },
+    )
+    .unwrap();
     let bvh = build_bvh2_from_tris(
         &tris,
         BvhBuildParams::medium_build(),
@@ -279,6 +291,13 @@ fn versus_obvhs(
                     .count()
             })
         });
+        g.bench_function(format!("closest_{name}_prism_kd_selects"), |b| {
+            b.iter(|| {
+                rays.iter()
+                    .filter(|r| selects.intersect(r, t_max).is_some())
+                    .count()
+            })
+        });
         g.bench_function(format!("closest_{name}_obvhs_own_test"), |b| {
             b.iter(|| obvhs_closest(&rays))
         });
@@ -303,6 +322,9 @@ fn versus_obvhs(
         });
         g.bench_function(format!("any_{name}_prism_kd_exact_build"), |b| {
             b.iter(|| rays.iter().filter(|r| exact.occluded(r, t_max)).count())
+        });
+        g.bench_function(format!("any_{name}_prism_kd_selects"), |b| {
+            b.iter(|| rays.iter().filter(|r| selects.occluded(r, t_max)).count())
         });
         g.bench_function(format!("any_{name}_obvhs_own_test"), |b| {
             b.iter(|| {
@@ -354,6 +376,13 @@ fn versus_obvhs(
         eprintln!("mesh_vs_obvhs/diffuse_{kind}: {} rays", rays.len());
         g.bench_function(format!("closest_diffuse_{kind}_prism_kd"), |b| {
             b.iter(|| prism_closest(rays))
+        });
+        g.bench_function(format!("closest_diffuse_{kind}_prism_kd_selects"), |b| {
+            b.iter(|| {
+                rays.iter()
+                    .filter(|r| selects.intersect(r, t_max).is_some())
+                    .count()
+            })
         });
         g.bench_function(format!("closest_diffuse_{kind}_obvhs_own_test"), |b| {
             b.iter(|| obvhs_closest(rays))

@@ -473,7 +473,7 @@ fn alias_table_pmf_is_normalized() {
             .map(|_| {
                 let x = r.next_u32();
                 // Mix of zeros and values spanning many orders of magnitude.
-                if x % 5 == 0 {
+                if x.is_multiple_of(5) {
                     0.0
                 } else {
                     2f32.powi((x >> 16) as i32 % 40 - 20)

@@ -1421,6 +1421,40 @@ mod tests {
     }
 
     #[test]
+    fn the_select_walk_finds_the_same_hits() {
+        // Rays leaving the surface, crossing it from inside and passing it from outside: the
+        // two oblique walks visit the same leaves in the same order, so every answer agrees.
+        let (p, f) = icosphere(4);
+        let walk = |select_walk| {
+            let params = KdParams {
+                select_walk,
+                ..TriangleMesh::kd_params()
+            };
+            TriangleMesh::with_params(p.clone(), f.clone(), None, None, &params).unwrap()
+        };
+        let (branches, selects) = (walk(false), walk(true));
+        let (mut hits, mut occluded) = (0, 0);
+        for i in 0..20_000u32 {
+            let u = |k: u32| ((i.wrapping_mul(2_654_435_761) >> k) % 10_007) as f32 / 10_007.0;
+            let o = Vec3::new(u(0), u(5), u(11)) * 3.0 - Vec3::splat(1.5);
+            let ray = Ray::new(o, Vec3::new(u(3), u(7), u(13)) - Vec3::splat(0.5));
+            let want = branches.intersect(&ray, f32::INFINITY);
+            assert_eq!(selects.intersect(&ray, f32::INFINITY), want, "{ray:?}");
+            let brute = branches.intersect_brute_force(&ray, f32::INFINITY);
+            assert_eq!(want.map(|h| h.t), brute.map(|h| h.t), "{ray:?}");
+            let shadow = branches.occluded(&ray, 0.5);
+            assert_eq!(selects.occluded(&ray, 0.5), shadow, "{ray:?}");
+            hits += usize::from(want.is_some());
+            occluded += usize::from(shadow);
+        }
+        // Origins inside the sphere (15.5 % of the cube, about 3,100) all hit it.
+        assert!(
+            hits > 3_000 && occluded > 500,
+            "{hits} hits, {occluded} occluded"
+        );
+    }
+
+    #[test]
     fn welding_and_closedness() {
         // A tetrahedron with one vertex duplicated (as a UV seam would do).
         let p = vec![

@@ -67,6 +67,10 @@ pub struct KdParams {
     /// (padded with the run's last primitive), so that data a caller lays out beside that
     /// array can be read in aligned blocks ([`KdTree::runs`]). 1 packs runs tightly.
     pub run_align: u32,
+    /// Walk oblique rays with selects instead of branches at each node: faster for the
+    /// incoherent rays that reach a dense mesh, slower where branches are predicted well
+    /// (coherent rays, shallow trees such as the scene-level one).
+    pub select_walk: bool,
 }
 
 impl Default for KdParams {
@@ -83,6 +87,7 @@ impl Default for KdParams {
             depth_per_doubling: 1.3,
             binned_above: 4096,
             run_align: 1,
+            select_walk: false,
         }
     }
 }
@@ -194,6 +199,7 @@ pub struct KdTree {
     indices: Vec<u32>,
     bounds: Aabb,
     stats: KdStats,
+    select_walk: bool,
 }
 
 impl KdTree {
@@ -207,6 +213,7 @@ impl KdTree {
             indices: built.indices,
             bounds: built.bounds,
             stats,
+            select_walk: params.select_walk,
         }
     }
 

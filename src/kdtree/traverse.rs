@@ -172,7 +172,11 @@ impl KdTree {
         let inv = Vec3A::ONE / d;
         if (inv.is_finite_mask() & d.is_finite_mask() & o.is_finite_mask()).all() {
             if let Some((t0, t1)) = self.bounds.intersect_oblique(o, inv, t_max) {
-                self.walk_from::<N, true>(ray, inv.into(), t0, t1, t_max, leaf);
+                if self.select_walk {
+                    self.walk_from::<N, true, true>(ray, inv.into(), t0, t1, t_max, leaf);
+                } else {
+                    self.walk_from::<N, true, false>(ray, inv.into(), t0, t1, t_max, leaf);
+                }
             }
             return;
         }
@@ -182,7 +186,7 @@ impl KdTree {
         }
         let inv_d = Vec3::from(inv);
         if let Some((t0, t1)) = self.bounds.intersect_p(ray, inv_d, t_max) {
-            self.walk_from::<N, false>(ray, inv_d, t0, t1, t_max, leaf);
+            self.walk_from::<N, false, false>(ray, inv_d, t0, t1, t_max, leaf);
         }
     }
 
@@ -195,7 +199,7 @@ impl KdTree {
     /// mispredict them often. Other rays, parallel to split planes or lying in them, take the
     /// general step.
     #[inline]
-    fn walk_from<const N: usize, const OBLIQUE: bool>(
+    fn walk_from<const N: usize, const OBLIQUE: bool, const SELECTS: bool>(
         &self,
         ray: &Ray,
         inv_d: Vec3,
@@ -231,7 +235,7 @@ impl KdTree {
                 let split = node.split();
                 let t_plane = (split - o[axis]) * inv[axis];
                 let (below, above) = (index + 1, node.above() as usize);
-                if OBLIQUE {
+                if OBLIQUE && SELECTS {
                     // Moving up the axis the below child comes first, moving down the above.
                     // A plane exactly at either end of the segment visits both sides, so a
                     // primitive touching the plane from either is seen (as the general step
@@ -271,6 +275,30 @@ impl KdTree {
                     t0 = f32::from_bits(sel(go_far, later.to_bits(), t0.to_bits()));
                     t1 = f32::from_bits(sel(go_far, t1.to_bits(), sooner.to_bits()));
                     cur = KdNode::from_bits(sel(go_far, n_far ^ opaque_zero, n_near));
+                    continue;
+                }
+                if OBLIQUE {
+                    // Moving up the axis the below child comes first, moving down the above.
+                    let (near, far) = if neg >> axis & 1 == 0 {
+                        (below, above)
+                    } else {
+                        (above, below)
+                    };
+                    // As the selects above, with branches: better where the rays are coherent
+                    // enough for them to be predicted (the scene-level tree).
+                    if t_plane < t0 {
+                        index = far;
+                    } else if t_plane > t1 {
+                        index = near;
+                    } else if self.nodes[near].is_empty_leaf() {
+                        index = far;
+                        t0 = t_plane;
+                    } else {
+                        push(&mut stack, &mut sp, far, t_plane, t1);
+                        index = near;
+                        t1 = t_plane;
+                    }
+                    cur = self.nodes[index];
                     continue;
                 }
                 // From on the plane, the side the ray heads into comes first.
@@ -468,10 +496,23 @@ mod tests {
 
     #[test]
     fn oblique_rays_through_planes_and_corners_match_brute_force() {
+        oblique_rays_match_brute_force_with(false);
+    }
+
+    #[test]
+    fn oblique_rays_match_brute_force_with_the_select_walk() {
+        oblique_rays_match_brute_force_with(true);
+    }
+
+    fn oblique_rays_match_brute_force_with(select_walk: bool) {
         // Rays with no zero direction component take the sign-based walk. Origins and targets
         // on the box faces (the split planes) put plane distances exactly at segment ends.
         let boxes = grid_boxes();
-        let tree = KdTree::build(&boxes, &KdParams::default());
+        let params = KdParams {
+            select_walk,
+            ..KdParams::default()
+        };
+        let tree = KdTree::build(&boxes, &params);
         let coords = [-1.0f32, 0.0, 1.0, 2.0, 3.0, 8.0, 15.0, 16.0];
         let (mut checked, mut hits) = (0, 0);
         for (i, &x) in coords.iter().enumerate() {
@@ -510,6 +551,15 @@ mod tests {
 
     #[test]
     fn leaf_queries_match_brute_force() {
+        leaf_queries_match_brute_force_with(false);
+    }
+
+    #[test]
+    fn leaf_queries_match_brute_force_with_the_select_walk() {
+        leaf_queries_match_brute_force_with(true);
+    }
+
+    fn leaf_queries_match_brute_force_with(select_walk: bool) {
         // Leaves handed out whole, with runs aligned to four as mesh trees have them (and
         // several boxes to a leaf). Bars across the grid straddle split planes, so a leaf can
         // report a hit beyond its own far end, before which a later leaf may hold a nearer one.
@@ -528,6 +578,7 @@ mod tests {
         let params = KdParams {
             run_align: 4,
             max_leaf_prims: 8,
+            select_walk,
             ..KdParams::default()
         };
         let tree = KdTree::build(&boxes, &params);
