@@ -220,14 +220,14 @@ fn versus_obvhs(
         },
     )
     .unwrap();
-    // The same tree walked with selects instead of branches (`KdParams::select_walk`).
-    let selects = TriangleMesh::with_params(
+    // The same tree walked with branches instead of selects (`KdParams::select_walk`).
+    let branches = TriangleMesh::with_params(
         mesh.positions().to_vec(),
         mesh.indices().to_vec(),
         Some(mesh.normals().to_vec()),
         mesh.uvs().map(<[Vec2]>::to_vec),
         &KdParams {
-            select_walk: true,
+            select_walk: false,
             ..TriangleMesh::kd_params()
         },
     )
@@ -291,10 +291,10 @@ fn versus_obvhs(
                     .count()
             })
         });
-        g.bench_function(format!("closest_{name}_prism_kd_selects"), |b| {
+        g.bench_function(format!("closest_{name}_prism_kd_branches"), |b| {
             b.iter(|| {
                 rays.iter()
-                    .filter(|r| selects.intersect(r, t_max).is_some())
+                    .filter(|r| branches.intersect(r, t_max).is_some())
                     .count()
             })
         });
@@ -323,8 +323,8 @@ fn versus_obvhs(
         g.bench_function(format!("any_{name}_prism_kd_exact_build"), |b| {
             b.iter(|| rays.iter().filter(|r| exact.occluded(r, t_max)).count())
         });
-        g.bench_function(format!("any_{name}_prism_kd_selects"), |b| {
-            b.iter(|| rays.iter().filter(|r| selects.occluded(r, t_max)).count())
+        g.bench_function(format!("any_{name}_prism_kd_branches"), |b| {
+            b.iter(|| rays.iter().filter(|r| branches.occluded(r, t_max)).count())
         });
         g.bench_function(format!("any_{name}_obvhs_own_test"), |b| {
             b.iter(|| {
@@ -377,10 +377,10 @@ fn versus_obvhs(
         g.bench_function(format!("closest_diffuse_{kind}_prism_kd"), |b| {
             b.iter(|| prism_closest(rays))
         });
-        g.bench_function(format!("closest_diffuse_{kind}_prism_kd_selects"), |b| {
+        g.bench_function(format!("closest_diffuse_{kind}_prism_kd_branches"), |b| {
             b.iter(|| {
                 rays.iter()
-                    .filter(|r| selects.intersect(r, t_max).is_some())
+                    .filter(|r| branches.intersect(r, t_max).is_some())
                     .count()
             })
         });

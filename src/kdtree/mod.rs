@@ -69,7 +69,7 @@ pub struct KdParams {
     pub run_align: u32,
     /// Walk oblique rays with selects instead of branches at each node: faster for the
     /// incoherent rays that reach a dense mesh, slower where branches are predicted well
-    /// (coherent rays, shallow trees such as the scene-level one).
+    /// (camera rays, and the scene-level tree over a few large shapes). Mesh trees use it.
     pub select_walk: bool,
 }
 
