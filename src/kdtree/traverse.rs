@@ -253,7 +253,8 @@ impl KdTree {
                     // step and kept only when the segment crosses the plane. Unlike the
                     // branchy step this one does not skip an empty near child: the test and
                     // the extra select cost more instructions than the visits they save
-                    // (box-crossing diffuse misses on the bunny: 2,030 against 1,600 per ray).
+                    // (box-crossing diffuse misses on the bunny: 2,030 against 1,600 instructions
+                    // per ray).
                     let down = neg >> axis & 1 != 0;
                     let near = sel(down, above, below);
                     let far = sel(down, below, above);
