@@ -622,6 +622,26 @@ mod tests {
     }
 
     #[test]
+    fn the_select_walk_stops_at_its_node_limit() {
+        let params = KdParams {
+            select_walk: true,
+            ..KdParams::default()
+        };
+        let small = KdTree::build(&grid_boxes(), &params);
+        assert!(small.select_walk());
+        // 48³ separate boxes need a leaf each, about twice as many nodes as boxes.
+        let mut boxes = Vec::new();
+        for i in 0..48 * 48 * 48 {
+            let p = Vec3::new((i % 48) as f32, (i / 48 % 48) as f32, (i / 2304) as f32) * 2.0;
+            boxes.push(Aabb::new(p, p + Vec3::ONE));
+        }
+        let big = KdTree::build(&boxes, &params);
+        assert!(big.stats().nodes > super::super::SELECT_WALK_MAX_NODES);
+        assert!(!big.select_walk());
+        assert!(!KdTree::build(&grid_boxes(), &KdParams::default()).select_walk());
+    }
+
+    #[test]
     fn callback_results_past_the_limit_are_ignored() {
         let boxes = grid_boxes();
         let tree = KdTree::build(&boxes, &KdParams::default());
