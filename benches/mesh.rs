@@ -207,31 +207,28 @@ fn versus_obvhs(
             Triangle { v0, v1, v2 }
         })
         .collect();
-    // The same mesh with the exact event sweep everywhere: the tree the builder made before
-    // binning, to compare trees on the same rays.
-    let exact = TriangleMesh::with_params(
-        mesh.positions().to_vec(),
-        mesh.indices().to_vec(),
-        Some(mesh.normals().to_vec()),
-        mesh.uvs().map(<[Vec2]>::to_vec),
-        &KdParams {
-            binned_above: usize::MAX,
-            ..TriangleMesh::kd_params()
-        },
-    )
-    .unwrap();
+    // The same mesh with other tree parameters.
+    let rebuilt = |params: KdParams| {
+        TriangleMesh::with_params(
+            mesh.positions().to_vec(),
+            mesh.indices().to_vec(),
+            Some(mesh.normals().to_vec()),
+            mesh.uvs().map(<[Vec2]>::to_vec),
+            &params,
+        )
+        .unwrap()
+    };
+    // The exact event sweep everywhere: the tree the builder made before binning, to compare
+    // trees on the same rays.
+    let exact = rebuilt(KdParams {
+        binned_above: usize::MAX,
+        ..TriangleMesh::kd_params()
+    });
     // The same tree walked with branches instead of selects (`KdParams::select_walk`).
-    let branches = TriangleMesh::with_params(
-        mesh.positions().to_vec(),
-        mesh.indices().to_vec(),
-        Some(mesh.normals().to_vec()),
-        mesh.uvs().map(<[Vec2]>::to_vec),
-        &KdParams {
-            select_walk: false,
-            ..TriangleMesh::kd_params()
-        },
-    )
-    .unwrap();
+    let branches = rebuilt(KdParams {
+        select_walk: false,
+        ..TriangleMesh::kd_params()
+    });
     let bvh = build_bvh2_from_tris(
         &tris,
         BvhBuildParams::medium_build(),
