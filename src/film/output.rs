@@ -340,7 +340,71 @@ fn encode_exr(path: &Path, img: &Image, meta: &ImageMeta) -> Result<Vec<u8>, Fil
             path: path.to_path_buf(),
             message: e.to_string(),
         })?;
-    Ok(out.into_inner())
+    let mut bytes = out.into_inner();
+    sort_exr_header(&mut bytes);
+    Ok(bytes)
+}
+
+/// Puts the attributes of a single-part EXR header in name order, as OpenEXR writes them. The
+/// `exr` crate writes custom attributes from a `HashMap`, in an order that changes from run to
+/// run, so the same image came out as different bytes. The attributes only move within the
+/// header, whose length stays the same, so the offsets after it still hold. Anything that does
+/// not parse as expected (multi-part or deep files) is left as it is.
+fn sort_exr_header(bytes: &mut [u8]) {
+    const MULTIPART_OR_DEEP: u32 = (1 << 11) | (1 << 12);
+    let Some(version) = bytes.get(4..8) else {
+        return;
+    };
+    let version = u32::from_le_bytes([version[0], version[1], version[2], version[3]]);
+    if version & MULTIPART_OR_DEEP != 0 {
+        return;
+    }
+    // Each attribute: name, NUL, type, NUL, a 4-byte little-endian size, the value.
+    let header_start = 8;
+    let mut attrs: Vec<(usize, usize)> = Vec::new();
+    let mut at = header_start;
+    loop {
+        match bytes.get(at) {
+            None => return,
+            Some(0) => break,
+            Some(_) => {}
+        }
+        let nul = |from: usize| bytes[from..].iter().position(|&b| b == 0).map(|i| from + i);
+        let Some(name_end) = nul(at) else {
+            return;
+        };
+        let Some(type_end) = nul(name_end + 1) else {
+            return;
+        };
+        let Some(size) = bytes.get(type_end + 1..type_end + 5) else {
+            return;
+        };
+        let size = i32::from_le_bytes([size[0], size[1], size[2], size[3]]);
+        let Ok(size) = usize::try_from(size) else {
+            return;
+        };
+        let end = type_end + 5 + size;
+        if end > bytes.len() {
+            return;
+        }
+        attrs.push((at, end));
+        at = end;
+    }
+    let header_end = at;
+    let name = |&(start, _): &(usize, usize)| {
+        let end = start + bytes[start..].iter().position(|&b| b == 0).unwrap_or(0);
+        &bytes[start..end]
+    };
+    let mut sorted = attrs.clone();
+    sorted.sort_by(|a, b| name(a).cmp(name(b)));
+    if sorted == attrs {
+        return;
+    }
+    let header: Vec<u8> = sorted
+        .iter()
+        .flat_map(|&(start, end)| bytes[start..end].iter().copied())
+        .collect();
+    bytes[header_start..header_end].copy_from_slice(&header);
 }
 
 /// Distinguishes temporary files of concurrent writes from one process.
@@ -713,6 +777,34 @@ mod tests {
         for (a, b) in img.pixels.iter().zip(&back.pixels) {
             assert_eq!(a.map(f32::to_bits), b.map(f32::to_bits));
         }
+        assert_eq!(meta, Some(META));
+    }
+
+    #[test]
+    fn exr_files_of_one_image_are_identical_bytes() {
+        // Each encode fills a fresh hash map of attributes, whose order is random: unsorted,
+        // eight encodes agree only by chance (odds about 1 in 6^7).
+        let path = Path::new("same.exr");
+        let first = encode_exr(path, &hdr_image(), &META).unwrap();
+        for _ in 0..7 {
+            assert_eq!(encode_exr(path, &hdr_image(), &META).unwrap(), first);
+        }
+        // The header is in name order and still reads back whole.
+        let names: Vec<&[u8]> = {
+            let mut at = 8;
+            let mut names = Vec::new();
+            while first[at] != 0 {
+                let nul = |from: usize| from + first[from..].iter().position(|&b| b == 0).unwrap();
+                let (name_end, type_end) = (nul(at), nul(nul(at) + 1));
+                let size =
+                    i32::from_le_bytes(first[type_end + 1..type_end + 5].try_into().unwrap());
+                names.push(&first[at..name_end]);
+                at = type_end + 5 + size as usize;
+            }
+            names
+        };
+        assert!(names.len() >= 6 && names.is_sorted(), "{names:?}");
+        let (_, meta) = decode_exr(path, first).unwrap();
         assert_eq!(meta, Some(META));
     }
 
