@@ -351,60 +351,58 @@ fn encode_exr(path: &Path, img: &Image, meta: &ImageMeta) -> Result<Vec<u8>, Fil
 /// header, whose length stays the same, so the offsets after it still hold. Anything that does
 /// not parse as expected (multi-part or deep files) is left as it is.
 fn sort_exr_header(bytes: &mut [u8]) {
-    const MULTIPART_OR_DEEP: u32 = (1 << 11) | (1 << 12);
-    let Some(version) = bytes.get(4..8) else {
+    let Some(mut attrs) = exr_header_attributes(bytes) else {
         return;
     };
-    let version = u32::from_le_bytes([version[0], version[1], version[2], version[3]]);
-    if version & MULTIPART_OR_DEEP != 0 {
+    let (Some(first), Some(last)) = (attrs.first(), attrs.last()) else {
         return;
-    }
-    // Each attribute: name, NUL, type, NUL, a 4-byte little-endian size, the value.
-    let header_start = 8;
-    let mut attrs: Vec<(usize, usize)> = Vec::new();
-    let mut at = header_start;
-    loop {
-        match bytes.get(at) {
-            None => return,
-            Some(0) => break,
-            Some(_) => {}
-        }
-        let nul = |from: usize| bytes[from..].iter().position(|&b| b == 0).map(|i| from + i);
-        let Some(name_end) = nul(at) else {
-            return;
-        };
-        let Some(type_end) = nul(name_end + 1) else {
-            return;
-        };
-        let Some(size) = bytes.get(type_end + 1..type_end + 5) else {
-            return;
-        };
-        let size = i32::from_le_bytes([size[0], size[1], size[2], size[3]]);
-        let Ok(size) = usize::try_from(size) else {
-            return;
-        };
-        let end = type_end + 5 + size;
-        if end > bytes.len() {
-            return;
-        }
-        attrs.push((at, end));
-        at = end;
-    }
-    let header_end = at;
-    let name = |&(start, _): &(usize, usize)| {
-        let end = start + bytes[start..].iter().position(|&b| b == 0).unwrap_or(0);
-        &bytes[start..end]
     };
-    let mut sorted = attrs.clone();
-    sorted.sort_by(|a, b| name(a).cmp(name(b)));
-    if sorted == attrs {
-        return;
-    }
-    let header: Vec<u8> = sorted
+    let (header_start, header_end) = (first.start, last.end);
+    attrs.sort_by(|a, b| bytes[a.start..a.name_end].cmp(&bytes[b.start..b.name_end]));
+    let header: Vec<u8> = attrs
         .iter()
-        .flat_map(|&(start, end)| bytes[start..end].iter().copied())
+        .flat_map(|a| bytes[a.start..a.end].iter().copied())
         .collect();
     bytes[header_start..header_end].copy_from_slice(&header);
+}
+
+/// Where an attribute of an EXR header lies: its name is `start..name_end`, the whole
+/// attribute (name, type, size, value) `start..end`.
+struct ExrAttribute {
+    start: usize,
+    name_end: usize,
+    end: usize,
+}
+
+/// The attributes of a single-part EXR header in file order; `None` for multi-part or deep
+/// files, or bytes that do not parse as a header.
+fn exr_header_attributes(bytes: &[u8]) -> Option<Vec<ExrAttribute>> {
+    const MULTIPART_OR_DEEP: u32 = (1 << 11) | (1 << 12);
+    let word = |at: usize| -> Option<[u8; 4]> { bytes.get(at..at + 4)?.try_into().ok() };
+    if u32::from_le_bytes(word(4)?) & MULTIPART_OR_DEEP != 0 {
+        return None;
+    }
+    let nul = |from: usize| Some(from + bytes.get(from..)?.iter().position(|&b| b == 0)?);
+    // Each attribute: name, NUL, type, NUL, a 4-byte little-endian size, the value; a NUL
+    // where the next name would start ends the header.
+    let mut attrs = Vec::new();
+    let mut at = 8;
+    while *bytes.get(at)? != 0 {
+        let name_end = nul(at)?;
+        let type_end = nul(name_end + 1)?;
+        let size = usize::try_from(i32::from_le_bytes(word(type_end + 1)?)).ok()?;
+        let end = type_end + 5 + size;
+        if end > bytes.len() {
+            return None;
+        }
+        attrs.push(ExrAttribute {
+            start: at,
+            name_end,
+            end,
+        });
+        at = end;
+    }
+    Some(attrs)
 }
 
 /// Distinguishes temporary files of concurrent writes from one process.
@@ -790,19 +788,8 @@ mod tests {
             assert_eq!(encode_exr(path, &hdr_image(), &META).unwrap(), first);
         }
         // The header is in name order and still reads back whole.
-        let names: Vec<&[u8]> = {
-            let mut at = 8;
-            let mut names = Vec::new();
-            while first[at] != 0 {
-                let nul = |from: usize| from + first[from..].iter().position(|&b| b == 0).unwrap();
-                let (name_end, type_end) = (nul(at), nul(nul(at) + 1));
-                let size =
-                    i32::from_le_bytes(first[type_end + 1..type_end + 5].try_into().unwrap());
-                names.push(&first[at..name_end]);
-                at = type_end + 5 + size as usize;
-            }
-            names
-        };
+        let attrs = exr_header_attributes(&first).unwrap();
+        let names: Vec<&[u8]> = attrs.iter().map(|a| &first[a.start..a.name_end]).collect();
         assert!(names.len() >= 6 && names.is_sorted(), "{names:?}");
         let (_, meta) = decode_exr(path, first).unwrap();
         assert_eq!(meta, Some(META));

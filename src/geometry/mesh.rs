@@ -1428,7 +1428,8 @@ mod tests {
     #[test]
     fn the_select_walk_finds_the_same_hits() {
         // Rays leaving the surface, crossing it from inside and passing it from outside: the
-        // two oblique walks visit the same leaves in the same order, so every answer agrees.
+        // two oblique walks offer the same non-empty leaves in the same order (only the select
+        // walk also steps into empty ones), so every answer agrees.
         let (p, f) = icosphere(4);
         let walk = |select_walk| {
             let params = KdParams {
