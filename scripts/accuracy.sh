@@ -1,5 +1,5 @@
 #!/usr/bin/env bash
-# Regenerates the figures of the README's "What accuracy costs" section into assets/accuracy/:
+# Regenerates the figures of docs/accuracy.md into assets/accuracy/:
 # convergence studies of the shipped scenes and the table of effect costs.
 # Usage: scripts/accuracy.sh [BUDGET_SECONDS]   (default 20 per configuration)
 set -euo pipefail

@@ -1,8 +1,8 @@
 #!/usr/bin/env python3
-"""Pastes the tables under assets/accuracy/ into README.md between marker comments."""
+"""Pastes the tables under assets/accuracy/ into docs/accuracy.md between marker comments."""
 import pathlib, re
 root = pathlib.Path(__file__).resolve().parent.parent
-readme = root / "README.md"
+readme = root / "docs" / "accuracy.md"
 text = readme.read_text()
 def table(path):
     lines = (root / path).read_text().splitlines()

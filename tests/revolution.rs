@@ -31,23 +31,16 @@ const EGG: [(f32, f32); 6] = [
     (0.0, 1.1),
 ];
 
-/// splitmix64: deterministic and independent of the crate's samplers.
-struct Rng(u64);
+#[path = "common/splitmix.rs"]
+mod splitmix;
+use splitmix::SplitMix as Rng;
 
-impl Rng {
-    fn next(&mut self) -> u64 {
-        self.0 = self.0.wrapping_add(0x9e37_79b9_7f4a_7c15);
-        let mut z = self.0;
-        z = (z ^ (z >> 30)).wrapping_mul(0xbf58_476d_1ce4_e5b9);
-        z = (z ^ (z >> 27)).wrapping_mul(0x94d0_49bb_1331_11eb);
-        z ^ (z >> 31)
-    }
-    fn f(&mut self) -> f64 {
-        (self.next() >> 11) as f64 / (1u64 << 53) as f64
-    }
-    fn range(&mut self, a: f64, b: f64) -> f64 {
-        a + (b - a) * self.f()
-    }
+/// A uniform direction on the unit sphere.
+trait Sphere {
+    fn sphere(&mut self) -> DVec3;
+}
+
+impl Sphere for Rng {
     fn sphere(&mut self) -> DVec3 {
         let z = self.range(-1.0, 1.0);
         let phi = self.range(0.0, std::f64::consts::TAU);
@@ -494,7 +487,7 @@ fn ray_mix(curve: &Curve, lo: DVec3, hi: DVec3, n: usize, rng: &mut Rng) -> Vec<
                     let b = rng.range(0.0, std::f64::consts::TAU);
                     let dir = e1 * b.cos() + e2 * b.sin();
                     let eps = 10f64.powf(-rng.range(1.0, 5.0));
-                    let side = if rng.f() < 0.5 { -1.0 } else { 1.0 };
+                    let side = if rng.unit() < 0.5 { -1.0 } else { 1.0 };
                     f32_ray(q - dir * radius + nrm * eps * side, dir * scale)
                 }
                 _ => {
