@@ -13,7 +13,7 @@ fn forms() -> Vec<Lanes> {
         println!("lanes: native width 8 (AVX2 + FMA) not on this CPU: skipped");
     }
     if Lanes::native16().is_none() {
-        println!("lanes: native width 16 (AVX-512F) not on this CPU: skipped");
+        println!("lanes: native width 16 (AVX-512F and BW) not on this CPU: skipped");
     }
     Lanes::all_available()
 }

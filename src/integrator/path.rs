@@ -4,10 +4,13 @@
 use super::bsdf::{fresnel_dielectric, fresnel_schlick, reflect, refract};
 use super::transport::{MediumOps, SpectralData, Transport};
 use crate::components::Material;
+use crate::components::camera::CameraFrame;
 use crate::geometry::{Ray, offset_ray_origin, spawn_ray_to};
 use crate::medium::{DistanceSample, Equiangular};
+use crate::sampling::warp::lanes as warp;
 use crate::sampling::{self, Sampler};
 use crate::scene_file::schema::{Fresnel, LightSampling};
+use crate::simd::{Float, UInt, V3, math};
 use crate::spectrum::Channels;
 use crate::systems::lights::{EquiangularTarget, LightSource};
 use crate::systems::primitives::NO_MEDIUM;
@@ -132,9 +135,118 @@ fn power_heuristic(a: f32, b: f32) -> f32 {
     if a2 + b2 == 0.0 { 0.0 } else { a2 / (a2 + b2) }
 }
 
-/// Starts the path of sample `index` of pixel (x, y): film position importance-sampled from
-/// a tent filter of radius one pixel, a lens position when the LENS effect is on, a time when
-/// MOTION is on.
+/// Camera rays of one lane of samples: where each starts, where it goes, and when.
+#[derive(Clone, Copy, Debug)]
+pub struct CameraRays<F: Float> {
+    pub o: V3<F>,
+    pub d: V3<F>,
+    pub time: F,
+}
+
+/// The camera frame's vectors in lanes: the same in every lane, or each lane's own for a
+/// camera moving within the shutter.
+struct FrameLanes<F: Float> {
+    origin: V3<F>,
+    forward: V3<F>,
+    right: V3<F>,
+    up: V3<F>,
+    half_x: F,
+    half_y: F,
+}
+
+impl<F: Float> FrameLanes<F> {
+    #[inline(always)]
+    fn splat(c: &CameraFrame) -> Self {
+        FrameLanes {
+            origin: V3::splat(c.origin),
+            forward: V3::splat(c.forward),
+            right: V3::splat(c.right),
+            up: V3::splat(c.up),
+            half_x: F::splat(c.half.x),
+            half_y: F::splat(c.half.y),
+        }
+    }
+}
+
+/// Samples `index` of pixels (x, y), one per lane: film position importance-sampled from a
+/// tent filter of radius one pixel, a lens position when the LENS effect is on, a time when
+/// MOTION is on. Lane `i` is exactly [`camera_ray`]'s ray for lane `i`'s sample.
+#[inline(always)]
+pub fn camera_rays<F: Float, const MOTION: bool>(
+    ctx: &Ctx,
+    x: F::U32,
+    y: F::U32,
+    index: F::U32,
+) -> CameraRays<F> {
+    type U<F> = <F as Float>::U32;
+    let scene = ctx.scene;
+    let s = &scene.settings;
+    let pixel = y.wrapping_mul(U::<F>::splat(ctx.width)).wrapping_add(x);
+    let sampler = &ctx.sampler;
+    let time = if MOTION {
+        let (open, close) = scene.shutter;
+        let u = sampler.get_1d_lanes::<F>(pixel, index, U::<F>::splat(DIM_TIME));
+        F::splat(open) + F::splat(close - open) * u
+    } else {
+        F::splat(scene.shutter.0)
+    };
+    // A camera moving within the shutter is evaluated at each ray's own time, one lane at a
+    // time (a spline through keyframes).
+    let cam = if MOTION && scene.camera_moves {
+        let path = scene
+            .camera_path
+            .as_ref()
+            .expect("camera_moves implies a path");
+        let mut frames = [scene.camera; 16];
+        for (i, f) in frames.iter_mut().enumerate().take(F::WIDTH) {
+            *f = path
+                .at(time.lane(i), &scene.base_camera)
+                .frame(s.width, s.height);
+        }
+        FrameLanes {
+            origin: V3::from_fn(|i| frames[i].origin),
+            forward: V3::from_fn(|i| frames[i].forward),
+            right: V3::from_fn(|i| frames[i].right),
+            up: V3::from_fn(|i| frames[i].up),
+            half_x: F::from_fn(|i| frames[i].half.x),
+            half_y: F::from_fn(|i| frames[i].half.y),
+        }
+    } else {
+        FrameLanes::splat(&scene.camera)
+    };
+    let (ux, uy) = sampler.get_2d_lanes::<F>(pixel, index, U::<F>::splat(DIM_FILM));
+    let half = F::splat(0.5);
+    let fx = x.i32_to_f32() + half + warp::sample_tent(ux);
+    let fy = y.i32_to_f32() + half + warp::sample_tent(uy);
+    let two = F::splat(2.0);
+    let sx = two * fx / F::splat(s.width as f32) - F::one();
+    let sy = F::one() - two * fy / F::splat(s.height as f32);
+    let dir = cam.forward + cam.right * (sx * cam.half_x) + cam.up * (sy * cam.half_y);
+    let dir = dir.normalize();
+    if ctx.lens {
+        let c = &scene.camera;
+        let (lx, ly) = sampler.get_2d_lanes::<F>(pixel, index, U::<F>::splat(DIM_LENS));
+        let (px, py) = lens_point_lanes(lx, ly, c.blades);
+        let a = F::splat(c.aperture_radius);
+        let o = cam.origin + cam.right * (px * a) + cam.up * (py * a);
+        // `dir` has unit length along `forward`, so this is the point on the focal plane.
+        let focus = cam.origin + dir * F::splat(c.focus_distance);
+        CameraRays {
+            o,
+            d: (focus - o).normalize(),
+            time,
+        }
+    } else {
+        CameraRays {
+            o: cam.origin,
+            d: dir,
+            time,
+        }
+    }
+}
+
+/// Starts the path of sample `index` of pixel (x, y): [`camera_rays`] at width 1, with the
+/// path's wavelengths.
 #[inline]
 pub fn camera_ray<T: Transport, const MOTION: bool>(
     ctx: &Ctx,
@@ -143,44 +255,8 @@ pub fn camera_ray<T: Transport, const MOTION: bool>(
     index: u32,
 ) -> PathState<T> {
     let pixel = y * ctx.width + x;
-    let time = if MOTION {
-        let (open, close) = ctx.scene.shutter;
-        open + (close - open) * ctx.sampler.get_1d(pixel, index, DIM_TIME)
-    } else {
-        ctx.scene.shutter.0
-    };
-    // A camera moving within the shutter is evaluated at each ray's own time.
-    let moved;
-    let cam = if MOTION && ctx.scene.camera_moves {
-        let s = &ctx.scene.settings;
-        let path = ctx
-            .scene
-            .camera_path
-            .as_ref()
-            .expect("camera_moves implies a path");
-        moved = path
-            .at(time, &ctx.scene.base_camera)
-            .frame(s.width, s.height);
-        &moved
-    } else {
-        &ctx.scene.camera
-    };
-    let u = ctx.sampler.get_2d(pixel, index, DIM_FILM);
-    let fx = x as f32 + 0.5 + sampling::sample_tent(u.x);
-    let fy = y as f32 + 0.5 + sampling::sample_tent(u.y);
-    let s = &ctx.scene.settings;
-    let sx = 2.0 * fx / s.width as f32 - 1.0;
-    let sy = 1.0 - 2.0 * fy / s.height as f32;
-    let dir = cam.forward + cam.right * (sx * cam.half.x) + cam.up * (sy * cam.half.y);
-    let mut ray = Ray::new(cam.origin, dir.normalize());
-    if ctx.lens {
-        let ul = ctx.sampler.get_2d(pixel, index, DIM_LENS);
-        let lp = lens_point(ul, cam.blades) * cam.aperture_radius;
-        let o = cam.origin + cam.right * lp.x + cam.up * lp.y;
-        // `dir` has unit length along `forward`, so this is the point on the focal plane.
-        let focus = cam.origin + dir * cam.focus_distance;
-        ray = Ray::new(o, (focus - o).normalize());
-    }
+    let r = camera_rays::<f32, MOTION>(ctx, x, y, index);
+    let ray = Ray::new(r.o.into(), r.d.into());
     let lambda = T::wavelengths(ctx, pixel, index);
     PathState {
         ray,
@@ -192,7 +268,7 @@ pub fn camera_ray<T: Transport, const MOTION: bool>(
         specular: false,
         prev_pdf: 0.0,
         prev_p: ray.o,
-        time,
+        time: r.time,
         pixel,
         sample: index,
         alive: true,
@@ -204,19 +280,25 @@ pub fn camera_ray<T: Transport, const MOTION: bool>(
 /// A point on the unit aperture: a disc, or a regular polygon with `blades` sides.
 #[inline]
 pub fn lens_point(u: Vec2, blades: u32) -> Vec2 {
+    let (x, y) = lens_point_lanes(u.x, u.y, blades);
+    Vec2::new(x, y)
+}
+
+/// [`lens_point`] over lanes.
+#[inline(always)]
+pub fn lens_point_lanes<F: Float>(ux: F, uy: F, blades: u32) -> (F, F) {
     if blades < 3 {
-        return sampling::square_to_uniform_disk_concentric(u);
+        return warp::square_to_uniform_disk_concentric(ux, uy);
     }
     // Pick one of the polygon's equal triangles, reuse the rest of u.x inside it.
-    let n = blades as f32;
-    let k = (u.x * n).floor().min(n - 1.0);
-    let ux = u.x * n - k;
-    let a0 = std::f32::consts::TAU * k / n;
-    let a1 = std::f32::consts::TAU * (k + 1.0) / n;
-    let b = sampling::square_to_uniform_triangle(Vec2::new(ux, u.y));
-    let p0 = Vec2::new(a0.cos(), a0.sin());
-    let p1 = Vec2::new(a1.cos(), a1.sin());
-    p0 * b.x + p1 * b.y
+    let n = F::splat(blades as f32);
+    let k = (ux * n).floor().min(n - F::one());
+    let ux = ux * n - k;
+    let tau = F::splat(std::f32::consts::TAU);
+    let (s0, c0) = math::sin_cos(tau * k / n);
+    let (s1, c1) = math::sin_cos(tau * (k + F::one()) / n);
+    let (b0, b1) = warp::square_to_uniform_triangle(ux, uy);
+    (c0 * b0 + c1 * b1, s0 * b0 + s1 * b1)
 }
 
 /// A reflected direction kept on the side of `n`: at grazing angles (or about a tilted shading
@@ -244,9 +326,9 @@ fn below(wt: Vec3, n: Vec3) -> Vec3 {
 
 /// Processes the vertex where `s.ray` ends: adds emission found there (MIS-weighted), then
 /// either ends the path or scatters it, returning a shadow ray for next-event estimation.
-#[inline]
 ///
 /// In a medium, a second shadow ray may come back in `extra`: the equiangular technique's.
+#[inline]
 pub fn shade<T: Transport, const MOTION: bool, const MEDIA: bool>(
     ctx: &Ctx,
     s: &mut PathState<T>,

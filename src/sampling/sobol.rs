@@ -4,43 +4,22 @@
 //! dimension pair gets its own independently scrambled copy of them, which
 //! avoids the poor 2-D projections of high Sobol dimensions.
 
-/// Generator matrix columns of Sobol dimension 1 (primitive polynomial x + 1,
-/// m₁ = 1): each column is the previous one XOR itself shifted right by one,
-/// i.e. Pascal's triangle mod 2, stored MSB-first.
-const SOBOL_DIM1: [u32; 32] = {
-    let mut v = [0u32; 32];
-    v[0] = 1 << 31;
-    let mut i = 1;
-    while i < 32 {
-        v[i] = v[i - 1] ^ (v[i - 1] >> 1);
-        i += 1;
-    }
-    v
-};
+use crate::simd::UInt;
 
-/// `SOBOL_DIM1_NIBBLES[k][b]`: XOR of the dimension-1 columns selected by the 4-bit value `b`
-/// placed at index bits 4k..4k+4, so a point costs eight lookups instead of a loop over bits.
-const SOBOL_DIM1_NIBBLES: [[u32; 16]; 8] = {
-    let mut t = [[0u32; 16]; 8];
-    let mut k = 0;
-    while k < 8 {
-        let mut b = 0;
-        while b < 16 {
-            let mut x = 0;
-            let mut j = 0;
-            while j < 4 {
-                if b & (1 << j) != 0 {
-                    x ^= SOBOL_DIM1[4 * k + j];
-                }
-                j += 1;
-            }
-            t[k][b] = x;
-            b += 1;
-        }
-        k += 1;
-    }
-    t
-};
+/// Sobol dimension 1 at `index`, with its digits in natural bit order (bit `i` holds the
+/// coefficient of 2^-(i+1)): the generator is Pascal's triangle mod 2, so the point is the
+/// index's bit polynomial B(t) shifted to B(1 + t) over GF(2). The shift splits in halves,
+/// B₀(t) + t^h B₁(t) ↦ (B₀ + B₁)(1 + t) + t^h B₁(1 + t), so five shift-and-XOR steps do it
+/// for 32 bits, in any lane width, with no table.
+#[inline(always)]
+pub fn sobol_dim1_reversed<U: UInt>(index: U) -> U {
+    let mut x = index;
+    x = x ^ (x.shri::<1>() & U::splat(0x5555_5555));
+    x = x ^ (x.shri::<2>() & U::splat(0x3333_3333));
+    x = x ^ (x.shri::<4>() & U::splat(0x0f0f_0f0f));
+    x = x ^ (x.shri::<8>() & U::splat(0x00ff_00ff));
+    x ^ (x.shri::<16>() & U::splat(0x0000_ffff))
+}
 
 /// Unscrambled Sobol point `index` in dimension `dim` (0 or 1) as a 0.32
 /// fixed-point fraction.
@@ -53,17 +32,26 @@ pub fn sobol_u32(index: u32, dim: u32) -> u32 {
     match dim {
         // Dimension 0's generator is the identity matrix read MSB-first.
         0 => index.reverse_bits(),
-        // XOR of the generator columns of the set bits, looked up a nibble at a time.
-        1 => {
-            let mut x = 0;
-            let mut k = 0;
-            while k < 8 {
-                x ^= SOBOL_DIM1_NIBBLES[k][((index >> (4 * k)) & 15) as usize];
-                k += 1;
-            }
-            x
-        }
+        1 => sobol_dim1_reversed(index).reverse_bits(),
         _ => panic!("sobol_u32: only dimensions 0 and 1 are provided, got {dim}"),
+    }
+}
+
+/// The two halves of a scramble seed: an addend and an odd multiplier.
+#[derive(Clone, Copy, Debug)]
+pub struct Scramble<U> {
+    pub add: U,
+    pub mul: U,
+}
+
+impl Scramble<u32> {
+    /// The seed a 64-bit value names: its low half adds, its high half (made odd) multiplies.
+    #[inline]
+    pub fn from_u64(seed: u64) -> Self {
+        Scramble {
+            add: seed as u32,
+            mul: (seed >> 32) as u32 | 1,
+        }
     }
 }
 
@@ -72,23 +60,20 @@ pub fn sobol_u32(index: u32, dim: u32) -> u32 {
 /// XOR with a function of the bits *below* `i`. Applied to bit-reversed values
 /// this is exactly the structure of a nested uniform (Owen) scramble; the seed
 /// decides the flips.
-#[inline]
-fn lk_permute(mut x: u32, seed: u64) -> u32 {
-    let add = seed as u32;
-    // Seed-dependent odd multiplier: mixes the seed into every bit level
-    // rather than only through the carry chain of the addition.
-    let mul = ((seed >> 32) as u32) | 1;
+#[inline(always)]
+fn lk_permute<U: UInt>(mut x: U, seed: Scramble<U>) -> U {
+    // The seed's odd multiplier mixes it into every bit level rather than only through the
+    // carry chain of the addition.
     // The even constants were chosen by measuring, over random seeds, how
     // close the flips of two inputs that first differ at bit j come to being
     // independent fair coins at every bit i > j (as in a true Owen scramble);
     // all 496 (j, i) pairs stay within 3σ of ideal at 4·10⁵ trials.
-    x ^= x.wrapping_mul(0xb6ec_cd98);
-    x = x.wrapping_add(add);
-    x = x.wrapping_mul(mul);
-    x ^= x.wrapping_mul(0x222d_8454);
-    x = x.wrapping_add(add.rotate_left(16));
-    x ^= x.wrapping_mul(0xa1e6_70a2);
-    x
+    x = x ^ x.wrapping_mul(U::splat(0xb6ec_cd98));
+    x = x.wrapping_add(seed.add);
+    x = x.wrapping_mul(seed.mul);
+    x = x ^ x.wrapping_mul(U::splat(0x222d_8454));
+    x = x.wrapping_add(seed.add.shli::<16>() | seed.add.shri::<16>());
+    x ^ x.wrapping_mul(U::splat(0xa1e6_70a2))
 }
 
 /// Hash-based nested uniform (Owen) scramble of a 0.32 fixed-point value:
@@ -98,34 +83,38 @@ fn lk_permute(mut x: u32, seed: u64) -> u32 {
 /// (t, m, s)-net properties, while randomising the points within them.
 #[inline]
 pub fn nested_uniform_scramble(x: u32, seed: u64) -> u32 {
-    lk_permute(x.reverse_bits(), seed).reverse_bits()
+    lk_permute(x.reverse_bits(), Scramble::from_u64(seed)).reverse_bits()
+}
+
+/// The index shuffle of [`owen_sobol_2d`]: the same nested-uniform structure applied to the
+/// index itself (not its reversal) only ever flips an index bit by a function of the bits
+/// *above* it, so indices `0..2^k` land on one aligned block of `2^k` consecutive indices.
+#[inline(always)]
+pub fn shuffle_index<U: UInt>(index: U, seed: Scramble<U>) -> U {
+    lk_permute(index.reverse_bits(), seed).reverse_bits()
 }
 
 /// Owen-scrambled Sobol point: the first two Sobol dimensions evaluated at
-/// a scrambled copy of `index`, each coordinate then scrambled independently.
-///
-/// Scrambling the index with the same nested-uniform structure (applied to
-/// the index itself rather than to its reversal) only ever flips an index bit
-/// by a function of the bits *above* it, so indices `0..2^k` land on one
-/// aligned block of `2^k` consecutive Sobol indices. Dimensions 0 and 1 form
-/// a (0, 2)-sequence, so any such block is a (0, k, 2)-net, which the
-/// coordinate scrambles preserve.
+/// a shuffled copy of `index` (see [`shuffle_index`]), each coordinate then
+/// scrambled independently. Dimensions 0 and 1 form a (0, 2)-sequence, so any
+/// aligned block of `2^k` indices is a (0, k, 2)-net, which the coordinate
+/// scrambles preserve.
 ///
 /// `seeds` are (index shuffle, x scramble, y scramble).
-#[inline]
-pub fn owen_sobol_2d(index: u32, seeds: [u64; 3]) -> (u32, u32) {
-    let i = nested_uniform_scramble(index, seeds[0]);
+#[inline(always)]
+pub fn owen_sobol_2d<U: UInt>(index: U, seeds: [Scramble<U>; 3]) -> (U, U) {
+    let i = shuffle_index(index, seeds[0]);
     (
         owen_sobol_x(i, seeds[1]),
-        nested_uniform_scramble(sobol_u32(i, 1), seeds[2]),
+        lk_permute(sobol_dim1_reversed(i), seeds[2]).reverse_bits(),
     )
 }
 
 /// Dimension 0 of [`owen_sobol_2d`] at an already shuffled index: Sobol
 /// dimension 0 is the bit reversal of the index, so scrambling it needs no
 /// reversal going in.
-#[inline]
-pub fn owen_sobol_x(shuffled_index: u32, seed: u64) -> u32 {
+#[inline(always)]
+pub fn owen_sobol_x<U: UInt>(shuffled_index: U, seed: Scramble<U>) -> U {
     lk_permute(shuffled_index, seed).reverse_bits()
 }
 
@@ -142,6 +131,26 @@ mod tests {
         assert_eq!(d0, [0.0, 0.5, 0.25, 0.75]);
         let d1: Vec<f64> = (0..8).map(|i| frac(sobol_u32(i, 1))).collect();
         assert_eq!(d1, [0.0, 0.5, 0.75, 0.25, 0.625, 0.125, 0.375, 0.875]);
+    }
+
+    #[test]
+    fn dimension_1_is_the_pascal_matrix() {
+        // Column j of the generator is column j - 1 XOR itself shifted right by one (MSB
+        // first); the point is the XOR of the columns of the index's set bits.
+        let mut cols = [0u32; 32];
+        cols[0] = 1 << 31;
+        for j in 1..32 {
+            cols[j] = cols[j - 1] ^ (cols[j - 1] >> 1);
+        }
+        let mut x = 0x9e37_79b9u32;
+        for k in 0..100_000u32 {
+            let index = if k < 4096 { k } else { x };
+            x = x.wrapping_mul(747_796_405).wrapping_add(2_891_336_453);
+            let by_columns = (0..32)
+                .filter(|j| index >> j & 1 == 1)
+                .fold(0, |acc, j| acc ^ cols[j]);
+            assert_eq!(sobol_u32(index, 1), by_columns, "index {index}");
+        }
     }
 
     #[test]

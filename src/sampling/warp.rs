@@ -1,20 +1,14 @@
 //! Warps from the unit square to common sampling domains, each next to the
 //! density it produces (with respect to length, area, or solid angle).
 
-use std::f32::consts::{FRAC_1_PI, FRAC_PI_2, FRAC_PI_4, TAU};
+use std::f32::consts::{FRAC_1_PI, TAU};
 
 use glam::{Vec2, Vec3};
 
 /// Tent of radius 1 on [-1, 1] by inverting its CDF; density `1 - |x|`.
 #[inline]
 pub fn sample_tent(u: f32) -> f32 {
-    if u < 0.5 {
-        (2.0 * u).sqrt() - 1.0
-    } else {
-        // 1 - u is exact for u ≥ 0.5, so the right half is as precise as
-        // the left.
-        1.0 - (2.0 * (1.0 - u)).sqrt()
-    }
+    lanes::sample_tent(u)
 }
 
 #[inline]
@@ -26,19 +20,8 @@ pub fn tent_pdf(x: f32) -> f32 {
 /// distortion, so it keeps the stratification of its input.
 #[inline]
 pub fn square_to_uniform_disk_concentric(u: Vec2) -> Vec2 {
-    let o = 2.0 * u - Vec2::ONE;
-    if o.x == 0.0 && o.y == 0.0 {
-        return Vec2::ZERO;
-    }
-    // Square rings map to circles; the angle advances linearly along each
-    // ring side.
-    let (r, theta) = if o.x.abs() > o.y.abs() {
-        (o.x, FRAC_PI_4 * (o.y / o.x))
-    } else {
-        (o.y, FRAC_PI_2 - FRAC_PI_4 * (o.x / o.y))
-    };
-    let (s, c) = theta.sin_cos();
-    r * Vec2::new(c, s)
+    let (x, y) = lanes::square_to_uniform_disk_concentric(u.x, u.y);
+    Vec2::new(x, y)
 }
 
 /// Density of [`square_to_uniform_disk_concentric`] per unit area.
@@ -50,9 +33,7 @@ pub fn uniform_disk_pdf() -> f32 {
 /// Cosine-weighted hemisphere about +z (Malley: lift a uniform disk point).
 #[inline]
 pub fn square_to_cosine_hemisphere(u: Vec2) -> Vec3 {
-    let d = square_to_uniform_disk_concentric(u);
-    let z = (1.0 - d.length_squared()).max(0.0).sqrt();
-    Vec3::new(d.x, d.y, z)
+    lanes::square_to_cosine_hemisphere(u.x, u.y).into()
 }
 
 /// Solid-angle density of [`square_to_cosine_hemisphere`]; zero below the
@@ -65,12 +46,7 @@ pub fn cosine_hemisphere_pdf(cos_theta: f32) -> f32 {
 /// Uniform over the unit sphere (Archimedes: z is uniform on [-1, 1]).
 #[inline]
 pub fn square_to_uniform_sphere(u: Vec2) -> Vec3 {
-    let z = 1.0 - 2.0 * u.x;
-    // 1 - z² factored as (1 - z)(1 + z) = 4u(1 - u): no cancellation at
-    // the poles.
-    let r = 2.0 * (u.x * (1.0 - u.x)).max(0.0).sqrt();
-    let (s, c) = (TAU * u.y).sin_cos();
-    Vec3::new(r * c, r * s, z)
+    lanes::square_to_uniform_sphere(u.x, u.y).into()
 }
 
 #[inline]
@@ -81,10 +57,7 @@ pub fn uniform_sphere_pdf() -> f32 {
 /// Uniform over the hemisphere about +z.
 #[inline]
 pub fn square_to_uniform_hemisphere(u: Vec2) -> Vec3 {
-    let z = u.x;
-    let r = ((1.0 - z) * (1.0 + z)).max(0.0).sqrt();
-    let (s, c) = (TAU * u.y).sin_cos();
-    Vec3::new(r * c, r * s, z)
+    lanes::square_to_uniform_hemisphere(u.x, u.y).into()
 }
 
 #[inline]
@@ -116,13 +89,7 @@ pub fn uniform_cone_pdf(cos_max: f32) -> f32 {
 /// [0, 2] directly.
 #[inline]
 pub fn square_to_uniform_cone_one_minus_cos(u: Vec2, one_minus_cos_max: f32) -> Vec3 {
-    // 1 - cos θ is uniform on [0, 1 - cos_max]. sin²θ = t (2 - t) keeps full
-    // relative precision for tiny t, where 1 - cos²θ would cancel to zero.
-    let t = u.x * one_minus_cos_max;
-    let cos_theta = 1.0 - t;
-    let sin_theta = (t * (2.0 - t)).max(0.0).sqrt();
-    let (s, c) = (TAU * u.y).sin_cos();
-    Vec3::new(sin_theta * c, sin_theta * s, cos_theta)
+    lanes::square_to_uniform_cone_one_minus_cos(u.x, u.y, one_minus_cos_max).into()
 }
 
 /// Solid-angle density of [`square_to_uniform_cone_one_minus_cos`].
@@ -137,13 +104,8 @@ pub fn uniform_cone_pdf_one_minus_cos(one_minus_cos_max: f32) -> f32 {
 /// strata stay compact (unlike the square-root map).
 #[inline]
 pub fn square_to_uniform_triangle(u: Vec2) -> Vec2 {
-    if u.x < u.y {
-        let b0 = 0.5 * u.x;
-        Vec2::new(b0, u.y - b0)
-    } else {
-        let b1 = 0.5 * u.y;
-        Vec2::new(u.x - b1, b1)
-    }
+    let (b0, b1) = lanes::square_to_uniform_triangle(u.x, u.y);
+    Vec2::new(b0, b1)
 }
 
 /// Density of [`square_to_uniform_triangle`] per unit area of the
@@ -161,11 +123,112 @@ pub fn uniform_triangle_pdf() -> f32 {
 /// switch avoids the singularity of the single-branch form.
 #[inline]
 pub fn coordinate_system(n: Vec3) -> (Vec3, Vec3) {
-    // n.z = -0 takes the -1 branch, which is just as valid there.
-    let sign = 1.0f32.copysign(n.z);
-    let a = -1.0 / (sign + n.z);
-    let b = n.x * n.y * a;
-    let t = Vec3::new(1.0 + sign * n.x * n.x * a, sign * b, -sign * n.x);
-    let bt = Vec3::new(b, sign + n.y * n.y * a, -n.y);
-    (t, bt)
+    let (t, b) = lanes::coordinate_system(n.into());
+    (t.into(), b.into())
+}
+
+/// The warps over lanes: the one implementation, which the scalar functions above call at
+/// width 1. Branches become selects, so lane `i` of a result is exactly the scalar result of
+/// lane `i`'s input.
+pub mod lanes {
+    use crate::simd::{Float, V3, math};
+    use std::f32::consts::{FRAC_PI_2, FRAC_PI_4, TAU};
+
+    /// See [`super::sample_tent`].
+    #[inline(always)]
+    pub fn sample_tent<F: Float>(u: F) -> F {
+        let one = F::one();
+        let two = F::splat(2.0);
+        // 1 - u is exact for u ≥ 0.5, so the right half is as precise as the left.
+        let left = (two * u).sqrt() - one;
+        let right = one - (two * (one - u)).sqrt();
+        F::select(u.lt(F::splat(0.5)), left, right)
+    }
+
+    /// See [`super::square_to_uniform_disk_concentric`].
+    #[inline(always)]
+    pub fn square_to_uniform_disk_concentric<F: Float>(ux: F, uy: F) -> (F, F) {
+        let one = F::one();
+        let ox = ux.mul_add(F::splat(2.0), -one);
+        let oy = uy.mul_add(F::splat(2.0), -one);
+        // Square rings map to circles; the angle advances linearly along each ring side.
+        let x_major = ox.abs().gt(oy.abs());
+        let r = F::select(x_major, ox, oy);
+        let ratio = F::select(x_major, oy, ox) / r;
+        let q = F::splat(FRAC_PI_4) * ratio;
+        let theta = F::select(x_major, q, F::splat(FRAC_PI_2) - q);
+        let (s, c) = math::sin_cos(theta);
+        // The centre (0/0 above) maps to itself.
+        let centre = ox.eq(F::zero()) & oy.eq(F::zero());
+        (
+            F::select(centre, F::zero(), r * c),
+            F::select(centre, F::zero(), r * s),
+        )
+    }
+
+    /// See [`super::square_to_cosine_hemisphere`].
+    #[inline(always)]
+    pub fn square_to_cosine_hemisphere<F: Float>(ux: F, uy: F) -> V3<F> {
+        let (x, y) = square_to_uniform_disk_concentric(ux, uy);
+        let z = (F::one() - x.mul_add(x, y * y)).max(F::zero()).sqrt();
+        V3::new(x, y, z)
+    }
+
+    /// See [`super::square_to_uniform_sphere`].
+    #[inline(always)]
+    pub fn square_to_uniform_sphere<F: Float>(ux: F, uy: F) -> V3<F> {
+        let one = F::one();
+        let z = ux.mul_add(F::splat(-2.0), one);
+        // 1 - z² factored as (1 - z)(1 + z) = 4u(1 - u): no cancellation at the poles.
+        let r = F::splat(2.0) * (ux * (one - ux)).max(F::zero()).sqrt();
+        let (s, c) = math::sin_cos(F::splat(TAU) * uy);
+        V3::new(r * c, r * s, z)
+    }
+
+    /// See [`super::square_to_uniform_hemisphere`].
+    #[inline(always)]
+    pub fn square_to_uniform_hemisphere<F: Float>(ux: F, uy: F) -> V3<F> {
+        let one = F::one();
+        let r = ((one - ux) * (one + ux)).max(F::zero()).sqrt();
+        let (s, c) = math::sin_cos(F::splat(TAU) * uy);
+        V3::new(r * c, r * s, ux)
+    }
+
+    /// See [`super::square_to_uniform_cone_one_minus_cos`].
+    #[inline(always)]
+    pub fn square_to_uniform_cone_one_minus_cos<F: Float>(
+        ux: F,
+        uy: F,
+        one_minus_cos_max: F,
+    ) -> V3<F> {
+        // 1 - cos θ is uniform on [0, 1 - cos_max]. sin²θ = t (2 - t) keeps full relative
+        // precision for tiny t, where 1 - cos²θ would cancel to zero.
+        let t = ux * one_minus_cos_max;
+        let cos_theta = F::one() - t;
+        let sin_theta = (t * (F::splat(2.0) - t)).max(F::zero()).sqrt();
+        let (s, c) = math::sin_cos(F::splat(TAU) * uy);
+        V3::new(sin_theta * c, sin_theta * s, cos_theta)
+    }
+
+    /// See [`super::square_to_uniform_triangle`].
+    #[inline(always)]
+    pub fn square_to_uniform_triangle<F: Float>(ux: F, uy: F) -> (F, F) {
+        let half = F::splat(0.5);
+        let upper = ux.lt(uy);
+        let b0 = half * ux;
+        let b1 = half * uy;
+        (F::select(upper, b0, ux - b1), F::select(upper, uy - b0, b1))
+    }
+
+    /// See [`super::coordinate_system`].
+    #[inline(always)]
+    pub fn coordinate_system<F: Float>(n: V3<F>) -> (V3<F>, V3<F>) {
+        // n.z = -0 takes the -1 branch, which is just as valid there.
+        let sign = F::one().copysign(n.z);
+        let a = -(sign + n.z).recip();
+        let b = n.x * n.y * a;
+        let t = V3::new(F::one() + sign * n.x * n.x * a, sign * b, -(sign * n.x));
+        let bt = V3::new(b, sign + n.y * n.y * a, -n.y);
+        (t, bt)
+    }
 }

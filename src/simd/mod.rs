@@ -6,7 +6,7 @@
 //! 16 exist in two forms with the same results bit for bit:
 //! - a portable form over plain arrays, which runs on any CPU (so every kernel is tested
 //!   everywhere);
-//! - a native form over AVX2 + FMA (8 lanes) or AVX-512F (16 lanes) registers on x86-64.
+//! - a native form over AVX2 + FMA (8 lanes) or AVX-512F/BW (16 lanes) registers on x86-64.
 //!
 //! Every operation is exactly rounded or defined bit for bit (fused multiply-add is fused in
 //! every form, `min`/`max` follow the SSE rule), so a kernel gives the same bits in the portable
@@ -333,7 +333,9 @@ fn has_avx2_fma() -> bool {
 
 #[cfg(target_arch = "x86_64")]
 fn has_avx512() -> bool {
-    has_avx2_fma() && std::arch::is_x86_feature_detected!("avx512f")
+    has_avx2_fma()
+        && std::arch::is_x86_feature_detected!("avx512f")
+        && std::arch::is_x86_feature_detected!("avx512bw")
 }
 
 impl Lanes {
@@ -367,7 +369,7 @@ impl Lanes {
         None
     }
 
-    /// Native width 16 (AVX-512F), if this CPU has it.
+    /// Native width 16 (AVX-512F and BW), if this CPU has it.
     pub fn native16() -> Option<Self> {
         #[cfg(target_arch = "x86_64")]
         if has_avx512() {
@@ -376,7 +378,7 @@ impl Lanes {
         None
     }
 
-    /// The widest native width: 16 with AVX-512F, 8 with AVX2 + FMA, else 1.
+    /// The widest native width: 16 with AVX-512F and BW, 8 with AVX2 + FMA, else 1.
     pub fn auto() -> Self {
         Self::native16()
             .or_else(Self::native8)
@@ -394,7 +396,7 @@ impl Lanes {
             SimdChoice::Auto => Ok(Self::auto()),
             SimdChoice::W1 => Ok(Self::scalar()),
             SimdChoice::W8 => Self::native8().ok_or_else(|| refuse(8, "AVX2 and FMA")),
-            SimdChoice::W16 => Self::native16().ok_or_else(|| refuse(16, "AVX-512F")),
+            SimdChoice::W16 => Self::native16().ok_or_else(|| refuse(16, "AVX-512F and AVX-512BW")),
         }
     }
 
@@ -424,7 +426,7 @@ impl Lanes {
         !matches!(self.0, Form::Portable8 | Form::Portable16)
     }
 
-    /// For messages and headers, e.g. `16 (AVX-512F)`.
+    /// For messages and headers, e.g. `16 (AVX-512)`.
     pub fn describe(self) -> String {
         let isa = match self.0 {
             Form::Scalar => "scalar",
@@ -434,7 +436,7 @@ impl Lanes {
             #[cfg(target_arch = "x86_64")]
             Form::Avx2 => "AVX2+FMA",
             #[cfg(target_arch = "x86_64")]
-            Form::Avx512 => "AVX-512F",
+            Form::Avx512 => "AVX-512",
         };
         format!("{} ({isa})", self.width())
     }

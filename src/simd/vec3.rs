@@ -146,3 +146,17 @@ impl<F: Float> MulAssign<F> for V3<F> {
         *self = *self * s;
     }
 }
+
+impl From<V3<f32>> for Vec3 {
+    #[inline(always)]
+    fn from(v: V3<f32>) -> Vec3 {
+        Vec3::new(v.x, v.y, v.z)
+    }
+}
+
+impl From<Vec3> for V3<f32> {
+    #[inline(always)]
+    fn from(v: Vec3) -> V3<f32> {
+        V3::new(v.x, v.y, v.z)
+    }
+}

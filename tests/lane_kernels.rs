@@ -1,0 +1,302 @@
+//! The sampler, the warps and camera rays over lanes: every width and form gives, lane for
+//! lane, the bits of the scalar functions, which are the same code at width 1.
+
+mod common;
+use common::render::scene_file;
+use glam::{Vec2, Vec3};
+use prism::integrator::Ctx;
+use prism::integrator::path::{camera_ray, camera_rays};
+use prism::integrator::transport::Rgb;
+use prism::sampling::warp::{self, lanes as lw};
+use prism::sampling::{Sampler, SamplerKind};
+use prism::simd::{self, Float, LaneKernel, Lanes, UInt, V3};
+use prism::systems::{Effect, RenderScene};
+use std::path::Path;
+
+#[path = "common/splitmix.rs"]
+mod splitmix;
+use splitmix::SplitMix;
+
+fn forms() -> Vec<Lanes> {
+    for (have, what) in [
+        (Lanes::native8().is_some(), "native width 8 (AVX2 + FMA)"),
+        (
+            Lanes::native16().is_some(),
+            "native width 16 (AVX-512F and BW)",
+        ),
+    ] {
+        if !have {
+            println!("lane kernels: {what} not on this CPU: skipped");
+        }
+    }
+    Lanes::all_available()
+}
+
+/// Runs `f` on `n` items in chunks of the lane width (the tail padded with item 0) and
+/// collects one `Vec<T>` per item.
+fn chunks<F: Float, T: Default + Clone>(
+    n: usize,
+    mut f: impl FnMut(&dyn Fn(usize) -> usize) -> Vec<Vec<T>>,
+) -> Vec<Vec<T>> {
+    let mut out = Vec::with_capacity(n);
+    for base in (0..n).step_by(F::WIDTH) {
+        let idx = move |l: usize| if base + l < n { base + l } else { 0 };
+        let lanes = f(&idx);
+        for (l, v) in lanes.into_iter().enumerate() {
+            if base + l < n {
+                out.push(v);
+            }
+        }
+    }
+    out
+}
+
+/// Lane `l` of a set of lane values, as f32 bits.
+fn bits_of<F: Float>(vals: &[F]) -> Vec<Vec<u32>> {
+    (0..F::WIDTH)
+        .map(|l| vals.iter().map(|v| v.lane(l).to_bits()).collect())
+        .collect()
+}
+
+struct SamplerKernel<'a> {
+    s: Sampler,
+    args: &'a [(u32, u32, u32)],
+}
+
+impl LaneKernel for SamplerKernel<'_> {
+    type Output = Vec<Vec<u32>>;
+    #[inline(always)]
+    fn run<F: Float>(self) -> Vec<Vec<u32>> {
+        let args = self.args;
+        chunks::<F, u32>(args.len(), |idx| {
+            let p = F::U32::from_fn(|l| args[idx(l)].0);
+            let i = F::U32::from_fn(|l| args[idx(l)].1);
+            let d = F::U32::from_fn(|l| args[idx(l)].2);
+            let x = self.s.get_1d_lanes::<F>(p, i, d);
+            let (u, v) = self.s.get_2d_lanes::<F>(p, i, d);
+            bits_of(&[x, u, v])
+        })
+    }
+}
+
+#[test]
+fn lane_samples_are_the_scalar_samples() {
+    let mut g = SplitMix(31);
+    let mut args: Vec<(u32, u32, u32)> = (0..20_000)
+        .map(|_| {
+            let r = g.next();
+            (r as u32, (r >> 32) as u32 % 70_000, (g.next() % 300) as u32)
+        })
+        .collect();
+    args.extend([
+        (0, 0, 0),
+        (u32::MAX, u32::MAX, u32::MAX),
+        (7, 1 << 31, 1 << 20),
+    ]);
+    for kind in [SamplerKind::Sobol, SamplerKind::Independent] {
+        let s = Sampler::new(kind, 77);
+        let want: Vec<Vec<u32>> = args
+            .iter()
+            .map(|&(p, i, d)| {
+                let v = s.get_2d(p, i, d);
+                vec![s.get_1d(p, i, d).to_bits(), v.x.to_bits(), v.y.to_bits()]
+            })
+            .collect();
+        for lanes in forms() {
+            let got = simd::dispatch(lanes, SamplerKernel { s, args: &args });
+            assert_eq!(got.len(), want.len());
+            for (k, (g, w)) in got.iter().zip(&want).enumerate() {
+                assert_eq!(g, w, "{kind:?} {} at {:?}", lanes.describe(), args[k]);
+            }
+        }
+    }
+}
+
+struct WarpKernel<'a>(&'a [(f32, f32)]);
+
+impl LaneKernel for WarpKernel<'_> {
+    type Output = Vec<Vec<u32>>;
+    #[inline(always)]
+    fn run<F: Float>(self) -> Vec<Vec<u32>> {
+        let u = self.0;
+        chunks::<F, u32>(u.len(), |idx| {
+            let ux = F::from_fn(|l| u[idx(l)].0);
+            let uy = F::from_fn(|l| u[idx(l)].1);
+            let (dx, dy) = lw::square_to_uniform_disk_concentric(ux, uy);
+            let c = lw::square_to_cosine_hemisphere(ux, uy);
+            let s = lw::square_to_uniform_sphere(ux, uy);
+            let h = lw::square_to_uniform_hemisphere(ux, uy);
+            let k = lw::square_to_uniform_cone_one_minus_cos(ux, uy, F::splat(0.01));
+            let (t0, t1) = lw::square_to_uniform_triangle(ux, uy);
+            let (ft, fb) = lw::coordinate_system(s);
+            bits_of(&[
+                lw::sample_tent(ux),
+                dx,
+                dy,
+                c.x,
+                c.y,
+                c.z,
+                s.x,
+                s.y,
+                s.z,
+                h.x,
+                h.y,
+                h.z,
+                k.x,
+                k.y,
+                k.z,
+                t0,
+                t1,
+                ft.x,
+                ft.y,
+                ft.z,
+                fb.x,
+                fb.y,
+                fb.z,
+            ])
+        })
+    }
+}
+
+#[test]
+fn lane_warps_are_the_scalar_warps() {
+    let mut g = SplitMix(32);
+    let mut u: Vec<(f32, f32)> = (0..20_000)
+        .map(|_| (g.range(0.0, 1.0) as f32, g.range(0.0, 1.0) as f32))
+        .collect();
+    // The square's centre, edges and corners, where the maps have their special cases.
+    for a in [0.0, 0.5, 1.0 - f32::EPSILON / 2.0] {
+        for b in [0.0, 0.5, 1.0 - f32::EPSILON / 2.0] {
+            u.push((a, b));
+        }
+    }
+    let want: Vec<Vec<u32>> = u
+        .iter()
+        .map(|&(x, y)| {
+            let p = Vec2::new(x, y);
+            let d = warp::square_to_uniform_disk_concentric(p);
+            let v3 = |v: Vec3| [v.x, v.y, v.z];
+            let s = warp::square_to_uniform_sphere(p);
+            let (ft, fb) = warp::coordinate_system(s);
+            let t = warp::square_to_uniform_triangle(p);
+            let mut r = vec![warp::sample_tent(x), d.x, d.y];
+            r.extend(v3(warp::square_to_cosine_hemisphere(p)));
+            r.extend(v3(s));
+            r.extend(v3(warp::square_to_uniform_hemisphere(p)));
+            r.extend(v3(warp::square_to_uniform_cone_one_minus_cos(p, 0.01)));
+            r.extend([t.x, t.y]);
+            r.extend(v3(ft));
+            r.extend(v3(fb));
+            r.iter().map(|v| v.to_bits()).collect()
+        })
+        .collect();
+    for lanes in forms() {
+        let got = simd::dispatch(lanes, WarpKernel(&u));
+        for (k, (g, w)) in got.iter().zip(&want).enumerate() {
+            assert_eq!(g, w, "{} at {:?}", lanes.describe(), u[k]);
+        }
+    }
+}
+
+struct CameraKernel<'a> {
+    ctx: Ctx<'a>,
+    motion: bool,
+    samples: &'a [(u32, u32, u32)],
+}
+
+impl LaneKernel for CameraKernel<'_> {
+    type Output = Vec<Vec<u32>>;
+    #[inline(always)]
+    fn run<F: Float>(self) -> Vec<Vec<u32>> {
+        let s = self.samples;
+        chunks::<F, u32>(s.len(), |idx| {
+            let x = F::U32::from_fn(|l| s[idx(l)].0);
+            let y = F::U32::from_fn(|l| s[idx(l)].1);
+            let i = F::U32::from_fn(|l| s[idx(l)].2);
+            let r = if self.motion {
+                camera_rays::<F, true>(&self.ctx, x, y, i)
+            } else {
+                camera_rays::<F, false>(&self.ctx, x, y, i)
+            };
+            let V3 {
+                x: ox,
+                y: oy,
+                z: oz,
+            } = r.o;
+            let V3 {
+                x: dx,
+                y: dy,
+                z: dz,
+            } = r.d;
+            bits_of(&[ox, oy, oz, dx, dy, dz, r.time])
+        })
+    }
+}
+
+fn shipped(name: &str) -> RenderScene {
+    let path = Path::new(env!("CARGO_MANIFEST_DIR"))
+        .join("scenes")
+        .join(name);
+    scene_file(&path, &[])
+}
+
+#[test]
+fn lane_camera_rays_are_the_scalar_camera_rays() {
+    // A pinhole, a thin lens, and a camera that moves within the shutter.
+    let cases = [
+        ("cornell.ron", false),
+        ("earth_dof.ron", false),
+        ("flyby.ron", true),
+    ];
+    for (name, motion) in cases {
+        let scene = shipped(name);
+        assert_eq!(scene.effects.has(Effect::Motion), motion, "{name}");
+        if name == "earth_dof.ron" {
+            assert!(scene.effects.has(Effect::Lens), "{name} has a lens");
+        }
+        if motion {
+            assert!(scene.camera_moves, "{name}: the camera moves");
+        }
+        let ctx = Ctx::new(&scene, scene.effects.has(Effect::Lens));
+        let (w, h) = (scene.settings.width, scene.settings.height);
+        let mut g = SplitMix(33);
+        let samples: Vec<(u32, u32, u32)> = (0..4000)
+            .map(|_| {
+                let r = g.next();
+                (
+                    (r as u32) % w,
+                    ((r >> 32) as u32) % h,
+                    (g.next() % 4096) as u32,
+                )
+            })
+            .collect();
+        let want: Vec<Vec<u32>> = samples
+            .iter()
+            .map(|&(x, y, i)| {
+                let p = if motion {
+                    camera_ray::<Rgb, true>(&ctx, x, y, i)
+                } else {
+                    camera_ray::<Rgb, false>(&ctx, x, y, i)
+                };
+                let (o, d) = (p.ray.o, p.ray.d);
+                [o.x, o.y, o.z, d.x, d.y, d.z, p.time]
+                    .iter()
+                    .map(|v| v.to_bits())
+                    .collect()
+            })
+            .collect();
+        for lanes in forms() {
+            let got = simd::dispatch(
+                lanes,
+                CameraKernel {
+                    ctx,
+                    motion,
+                    samples: &samples,
+                },
+            );
+            for (k, (g, w)) in got.iter().zip(&want).enumerate() {
+                assert_eq!(g, w, "{name} {} at {:?}", lanes.describe(), samples[k]);
+            }
+        }
+    }
+}
