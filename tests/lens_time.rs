@@ -166,9 +166,10 @@ fn static_pinhole_scenes_draw_no_lens_or_time_samples() {
 }
 
 /// Hash of the pixels of `cornell.ron` at 24×24 and 8 spp. It was first taken before the LENS
-/// and MOTION effects existed, and again when the sampler moved to 32-bit lane hashes; a
+/// and MOTION effects existed, and again when the sampler moved to 32-bit lane hashes and the BSDFs to the
+/// local shading frame; a
 /// change that shifts any sample dimension changes it.
-const GOLDEN_CORNELL_24: u64 = 0xed3c_c1ad_553f_edc7;
+const GOLDEN_CORNELL_24: u64 = 0xbcbd_2f59_a431_6ccd;
 
 #[test]
 fn forcing_motion_on_a_static_scene_changes_nothing() {

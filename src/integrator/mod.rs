@@ -237,25 +237,37 @@ fn render_with<T: WithQueues, const MEDIA: bool, const MOTION: bool>(
             .map(|tile| {
                 let mut film = vec![[0.0f64; 3]; tile.pixels()];
                 let mut st = RenderStats::default();
+                // Width 1 runs inside its entry point so the lane code it inlines (warps,
+                // BSDFs, camera rays, lane math) uses the CPU's FMA.
                 match opts.integrator {
                     Integrator::Wavefront => T::with_queues(|q| {
-                        wavefront::render_tile::<T, MOTION, MEDIA>(
-                            &ctx,
-                            q,
-                            tile,
-                            s0,
-                            s0 + n,
-                            &mut film,
-                            &mut st,
+                        crate::simd::scalar_entry(
+                            #[inline(always)]
+                            || {
+                                wavefront::render_tile::<T, MOTION, MEDIA>(
+                                    &ctx,
+                                    q,
+                                    tile,
+                                    s0,
+                                    s0 + n,
+                                    &mut film,
+                                    &mut st,
+                                )
+                            },
                         )
                     }),
-                    Integrator::Reference => reference::render_tile::<T, MOTION, MEDIA>(
-                        &ctx,
-                        tile,
-                        s0,
-                        s0 + n,
-                        &mut film,
-                        &mut st,
+                    Integrator::Reference => crate::simd::scalar_entry(
+                        #[inline(always)]
+                        || {
+                            reference::render_tile::<T, MOTION, MEDIA>(
+                                &ctx,
+                                tile,
+                                s0,
+                                s0 + n,
+                                &mut film,
+                                &mut st,
+                            )
+                        },
                     ),
                 }
                 st.revolution += crate::systems::primitives::take_revolution_stats();

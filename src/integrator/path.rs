@@ -1,7 +1,7 @@
 //! One path vertex at a time: camera rays and the shading step shared by the wavefront
 //! stages and the reference integrator, so both simulate exactly the same physics.
 
-use super::bsdf::{fresnel_dielectric, fresnel_schlick, reflect, refract};
+use super::bsdf::{Dielectric, Diffuse, Frame, Mirror, Mode};
 use super::transport::{MediumOps, SpectralData, Transport};
 use crate::components::Material;
 use crate::components::camera::CameraFrame;
@@ -247,7 +247,7 @@ pub fn camera_rays<F: Float, const MOTION: bool>(
 
 /// Starts the path of sample `index` of pixel (x, y): [`camera_rays`] at width 1, with the
 /// path's wavelengths.
-#[inline]
+#[inline(always)]
 pub fn camera_ray<T: Transport, const MOTION: bool>(
     ctx: &Ctx,
     x: u32,
@@ -328,7 +328,7 @@ fn below(wt: Vec3, n: Vec3) -> Vec3 {
 /// either ends the path or scatters it, returning a shadow ray for next-event estimation.
 ///
 /// In a medium, a second shadow ray may come back in `extra`: the equiangular technique's.
-#[inline]
+#[inline(always)]
 pub fn shade<T: Transport, const MOTION: bool, const MEDIA: bool>(
     ctx: &Ctx,
     s: &mut PathState<T>,
@@ -440,22 +440,27 @@ pub fn shade<T: Transport, const MOTION: bool, const MEDIA: bool>(
     // surface; `nsf` (the shading normal) shapes the scattering.
     let nf = sp.facing();
     let nsf = sp.shading_facing();
+    let frame = Frame::<f32>::from_normal(nsf.into());
+    let wo_l = frame.to_local(wo.into());
     let mut shadow = None;
     match material {
         Material::Diffuse { albedo } => {
             // Evaluated once for the light sample and the bounce (spectrally it is a sigmoid
             // at four wavelengths, not free).
-            let refl = T::reflectance(ctx, mat, albedo, tex_albedo.is_some(), &s.lambda);
+            let bsdf = Diffuse {
+                albedo: T::reflectance(ctx, mat, albedo, tex_albedo.is_some(), &s.lambda),
+            };
             if ctx.nee {
                 let u_sel = ctx.sampler.get_1d(pixel, index, dim);
                 let u_l = ctx.sampler.get_2d(pixel, index, dim + 1);
                 if let Some(ls) =
                     lights.sample::<MOTION>(prims, sp.p, u_sel, u_l, s.time, ctx.textures)
                 {
-                    let cos = ls.wi.dot(nsf);
+                    let wi_l = frame.to_local(ls.wi.into());
+                    let cos = wi_l.z;
                     if cos > 0.0 && ls.wi.dot(nf) > 0.0 {
-                        let bsdf_pdf = cos * std::f32::consts::FRAC_1_PI;
-                        let f = refl * std::f32::consts::FRAC_1_PI * cos;
+                        let bsdf_pdf = bsdf.pdf(wo_l, wi_l);
+                        let f = bsdf.eval(wo_l, wi_l) * cos;
                         let w = if ls.delta {
                             1.0
                         } else {
@@ -489,56 +494,49 @@ pub fn shade<T: Transport, const MOTION: bool, const MEDIA: bool>(
                 }
             }
             let u = ctx.sampler.get_2d(pixel, index, dim + 4);
-            let local = sampling::square_to_cosine_hemisphere(u);
-            let (t, b) = sampling::coordinate_system(nsf);
-            let wi = (t * local.x + b * local.y + nsf * local.z).normalize();
+            let bs = bsdf.sample(wo_l, u.x, u.y);
+            let wi: Vec3 = frame.to_world(bs.wi).normalize().into();
             if wi.dot(nf) <= 0.0 {
                 // Sampled around a tilted shading normal into the geometric back side: the
                 // surface absorbs it rather than letting light through.
                 s.alive = false;
                 return shadow;
             }
-            s.beta *= refl;
-            s.prev_pdf = sampling::cosine_hemisphere_pdf(local.z);
+            s.beta *= bs.weight;
+            s.prev_pdf = bs.pdf;
             s.specular = false;
             s.ray = Ray::new(offset_ray_origin(sp.p, nf), wi);
         }
         Material::Mirror { tint } => {
-            s.beta *= T::reflectance(ctx, mat, tint, tex_albedo.is_some(), &s.lambda);
+            let bsdf = Mirror {
+                tint: T::reflectance(ctx, mat, tint, tex_albedo.is_some(), &s.lambda),
+            };
+            let bs = bsdf.sample(wo_l);
+            s.beta *= bs.weight;
             s.specular = true;
-            s.ray = Ray::new(
-                offset_ray_origin(sp.p, nf),
-                reflect_above(reflect(wo, nsf), nf),
-            );
+            let wi: Vec3 = frame.to_world(bs.wi).into();
+            s.ray = Ray::new(offset_ray_origin(sp.p, nf), reflect_above(wi, nf));
         }
         Material::Dielectric { ior } => {
             // The geometric normal points out of a closed shape: entering on its front.
             let n = T::eta(&ior, &mut s.lambda, &mut s.beta);
-            let eta = if sp.front { n } else { 1.0 / n };
-            let cos_i = wo.dot(nsf).max(0.0);
-            let r = if ctx.schlick {
-                fresnel_schlick(cos_i, eta)
-            } else {
-                fresnel_dielectric(cos_i, eta)
+            let bsdf = Dielectric {
+                eta: if sp.front { n } else { 1.0 / n },
+                schlick: ctx.schlick,
             };
             let u = ctx.sampler.get_1d(pixel, index, dim + 3);
+            let bs = bsdf.sample::<T::S>(wo_l, u, Mode::Radiance);
             s.specular = true;
-            match refract(wo, nsf, eta) {
-                Some(wt) if u >= r => {
-                    // Radiance is compressed by 1/η² crossing into a denser medium.
-                    s.beta /= eta * eta;
-                    s.eta_scale *= eta * eta;
-                    if MEDIA {
-                        s.medium = prims.medium_after_crossing(hit.prim, sp.front, s.medium);
-                    }
-                    s.ray = Ray::new(offset_ray_origin(sp.p, -nf), below(wt, nf));
+            s.beta *= bs.weight;
+            let wi: Vec3 = frame.to_world(bs.wi).into();
+            if bs.is_transmission() {
+                s.eta_scale *= bs.eta * bs.eta;
+                if MEDIA {
+                    s.medium = prims.medium_after_crossing(hit.prim, sp.front, s.medium);
                 }
-                _ => {
-                    s.ray = Ray::new(
-                        offset_ray_origin(sp.p, nf),
-                        reflect_above(reflect(wo, nsf), nf),
-                    );
-                }
+                s.ray = Ray::new(offset_ray_origin(sp.p, -nf), below(wi, nf));
+            } else {
+                s.ray = Ray::new(offset_ray_origin(sp.p, nf), reflect_above(wi, nf));
             }
         }
         Material::Light { .. } | Material::Boundary => {
@@ -602,7 +600,7 @@ struct Segment {
 /// non-zero (where (b) is the only one, `w_b = 1`), so the sum is unbiased. Every factor is
 /// known at each technique's sample, and (b)'s weight does not involve (c), so emitters hit
 /// by chance need nothing about the segment they were reached from.
-#[inline]
+#[inline(always)]
 fn equiangular_nee<T: Transport, const MOTION: bool>(
     ctx: &Ctx,
     s: &PathState<T>,
@@ -698,7 +696,7 @@ fn shadow_ray_to_area(p: Vec3, q: Vec3, nq: Vec3) -> Ray {
 /// A scattering event inside a medium: next-event estimation through the phase function
 /// (MIS with phase sampling and with the equiangular technique, see [`equiangular_nee`]),
 /// then a phase-sampled continuation.
-#[inline]
+#[inline(always)]
 fn scatter_in_medium<T: Transport, const MOTION: bool>(
     ctx: &Ctx,
     s: &mut PathState<T>,

@@ -6,6 +6,7 @@ use super::path::{Ctx, camera_ray, shade};
 use super::transport::{MediumOps, Transport};
 use super::{RenderStats, Tile};
 
+#[inline(always)]
 pub fn render_tile<T: Transport, const MOTION: bool, const MEDIA: bool>(
     ctx: &Ctx,
     tile: &Tile,

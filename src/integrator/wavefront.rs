@@ -174,6 +174,7 @@ impl<T: Transport> Default for Queues<T> {
 
 /// Renders samples `s0..s1` of every pixel of `tile`, adding each finished path's radiance to
 /// `film` (the tile's pixels, row-major).
+#[inline(always)]
 pub fn render_tile<T: Transport, const MOTION: bool, const MEDIA: bool>(
     ctx: &Ctx,
     q: &mut Queues<T>,

@@ -449,6 +449,23 @@ pub trait LaneKernel {
     fn run<F: Float>(self) -> Self::Output;
 }
 
+/// Runs `f` inside width 1's entry point, so the lane code it inlines uses the CPU's FMA
+/// (outside it, `f32::mul_add` compiles to a call into the runtime's `fmaf`). Mark the closure
+/// `#[inline(always)]`, and what it calls likewise: code that is not inlined is compiled for
+/// the baseline CPU.
+#[inline(always)]
+pub fn scalar_entry<R>(f: impl FnOnce() -> R) -> R {
+    struct Once<C>(C);
+    impl<R, C: FnOnce() -> R> LaneKernel for Once<C> {
+        type Output = R;
+        #[inline(always)]
+        fn run<F: Float>(self) -> R {
+            (self.0)()
+        }
+    }
+    dispatch(Lanes::scalar(), Once(f))
+}
+
 /// Runs `k` instantiated at the lane type of `lanes`, inside an entry point compiled for that
 /// width's instruction set.
 pub fn dispatch<K: LaneKernel>(lanes: Lanes, k: K) -> K::Output {
