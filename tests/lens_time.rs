@@ -180,3 +180,50 @@ fn forcing_motion_on_a_static_scene_changes_nothing() {
     let forced = run(&a, Integrator::Wavefront);
     assert_eq!(plain.sums, forced.sums);
 }
+
+/// A small emitter (radius 0.2 px) whose image is centred at (15.75, 15.75) on a 32×32 film:
+/// 0.25 px right of and below pixel (15, 15)'s centre, wholly inside that pixel.
+fn off_centre_point(filter: &str) -> Image {
+    let px = 2.0 * 10f32.to_radians().tan() / 32.0 * 10.0;
+    image(&format!(
+        r#"Scene(
+    render: (width: 32, height: 32, spp: 4096, max_depth: 0, seed: 3, filter: {filter}),
+    camera: (position: (0.0, 0.0, 0.0), look_at: (0.0, 0.0, -1.0), fov_y: 20.0),
+    entities: [ (name: "point", shape: Sphere(center: ({x}, {y}, -10.0), radius: {r}),
+                 material: Light(emission: Rgb(1.0, 1.0, 1.0))) ],
+)"#,
+        x = -0.25 * px,
+        y = 0.25 * px,
+        r = 0.2 * px
+    ))
+}
+
+#[test]
+fn a_box_filter_keeps_a_point_in_its_pixel_and_the_tent_spreads_it() {
+    // Box: only pixel (15, 15) draws samples over the emitter, so the pixel-centre moments
+    // have no spread at all. Tent: pixels 15 and 16 of each axis see it with the tent's
+    // weights at 0.25 and 0.75 px, 3/4 and 1/4 (the tent is linear over the emitter), so the
+    // variance per axis is 3/16, and the centroid sits on the emitter.
+    let boxed = moments(&off_centre_point("Box"));
+    let tent = moments(&off_centre_point("Tent"));
+    assert!(boxed.3 < 1e-9 && boxed.4 < 1e-9, "box spread {boxed:?}");
+    assert!((boxed.1 - 15.5).abs() < 1e-9 && (boxed.2 - 15.5).abs() < 1e-9);
+    // About 500 hits (π·0.2² of 4096 samples): the far pixel's share is 1/4 ± 0.02 (1σ), so
+    // 0.06 is 3σ for the centroid and 6σ for the variance (3/16 ± 0.01).
+    assert!(
+        (tent.3 - 0.1875).abs() < 0.06 && (tent.4 - 0.1875).abs() < 0.06,
+        "{tent:?}"
+    );
+    assert!(
+        (tent.1 - 15.75).abs() < 0.06 && (tent.2 - 15.75).abs() < 0.06,
+        "{tent:?}"
+    );
+    // Both filters integrate to one: the same power reaches the film (two counts of about
+    // 500 hits: 20 % is over 3σ).
+    assert!(
+        (tent.0 / boxed.0 - 1.0).abs() < 0.2,
+        "{} vs {}",
+        tent.0,
+        boxed.0
+    );
+}

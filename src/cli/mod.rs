@@ -559,7 +559,7 @@ fn info(a: InfoArgs) -> Result<(), CliError> {
     let s = &rs.settings;
     println!("scene: {}", a.scene.display());
     println!(
-        "render: {}x{}, {} spp, max depth {}, seed {}, {:?} light sampling, rr depth {}, {:?} Fresnel, {:?} sampler",
+        "render: {}x{}, {} spp, max depth {}, seed {}, {:?} light sampling, rr depth {}, {:?} Fresnel, {:?} sampler, {:?} filter",
         s.width,
         s.height,
         s.spp,
@@ -568,7 +568,8 @@ fn info(a: InfoArgs) -> Result<(), CliError> {
         s.light_sampling,
         s.rr_depth,
         s.fresnel,
-        s.sampler
+        s.sampler,
+        s.filter
     );
     println!("entities: {}", rs.prims.len());
     for i in 0..rs.prims.len() {

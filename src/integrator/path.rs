@@ -50,6 +50,8 @@ pub struct Ctx<'a> {
     pub textures: bool,
     pub normal_maps: bool,
     pub equiangular: bool,
+    /// A box pixel filter instead of the tent.
+    pub box_filter: bool,
     /// Spectral forms of the scene's colours (empty in RGB transport).
     pub spectral: &'a SpectralData,
     /// One wavelength per path instead of four (`render.integrator.wavelengths: 1`).
@@ -81,6 +83,7 @@ impl<'a> Ctx<'a> {
             textures: scene.effects.has(crate::systems::Effect::Textures),
             normal_maps: scene.effects.has(crate::systems::Effect::NormalMaps),
             equiangular: s.equiangular,
+            box_filter: s.filter == crate::scene_file::schema::Filter::Box,
             spectral: &NO_SPECTRAL_DATA,
             single_wavelength: s.wavelengths == 1,
         }
@@ -168,8 +171,8 @@ impl<F: Float> FrameLanes<F> {
     }
 }
 
-/// Samples `index` of pixels (x, y), one per lane: film position importance-sampled from a
-/// tent filter of radius one pixel, a lens position when the LENS effect is on, a time when
+/// Samples `index` of pixels (x, y), one per lane: film position importance-sampled from the
+/// pixel filter (a tent of radius one pixel, or a box of one pixel), a lens position when the LENS effect is on, a time when
 /// MOTION is on. Lane `i` is exactly [`camera_ray`]'s ray for lane `i`'s sample.
 #[inline(always)]
 pub fn camera_rays<F: Float, const MOTION: bool>(
@@ -216,8 +219,14 @@ pub fn camera_rays<F: Float, const MOTION: bool>(
     };
     let (ux, uy) = sampler.get_2d_lanes::<F>(pixel, index, U::<F>::splat(DIM_FILM));
     let half = F::splat(0.5);
-    let fx = x.i32_to_f32() + half + warp::sample_tent(ux);
-    let fy = y.i32_to_f32() + half + warp::sample_tent(uy);
+    // Offsets from the pixel centre, distributed as the filter (one branch per packet).
+    let (ox, oy) = if ctx.box_filter {
+        (ux - half, uy - half)
+    } else {
+        (warp::sample_tent(ux), warp::sample_tent(uy))
+    };
+    let fx = x.i32_to_f32() + half + ox;
+    let fy = y.i32_to_f32() + half + oy;
     let two = F::splat(2.0);
     let sx = two * fx / F::splat(s.width as f32) - F::one();
     let sy = F::one() - two * fy / F::splat(s.height as f32);

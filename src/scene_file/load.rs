@@ -21,6 +21,7 @@ pub struct RenderSettings {
     pub wavelengths: u32,
     pub sampler: schema::SamplerChoice,
     pub equiangular: bool,
+    pub filter: schema::Filter,
 }
 
 /// A loaded scene: the world of entities and the resources beside it.
@@ -114,6 +115,7 @@ pub const OVERRIDE_KEYS: &[&str] = &[
     "render.integrator.wavelengths",
     "render.integrator.sampler",
     "render.integrator.equiangular",
+    "render.filter",
     "camera.position",
     "camera.look_at",
     "camera.up",
@@ -155,6 +157,7 @@ pub fn apply_override(scene: &mut schema::Scene, key: &str, value: &str) -> Resu
         "render.integrator.wavelengths" => r.integrator.wavelengths = val(key, value)?,
         "render.integrator.sampler" => r.integrator.sampler = val(key, value)?,
         "render.integrator.equiangular" => r.integrator.equiangular = val(key, value)?,
+        "render.filter" => r.filter = val(key, value)?,
         "camera.position" => c.position = val(key, value)?,
         "camera.look_at" => c.look_at = val(key, value)?,
         "camera.up" => c.up = val(key, value)?,
@@ -235,6 +238,7 @@ fn build_world(scene: schema::Scene, path: &Path, hash: u64) -> Result<LoadedSce
         wavelengths: r.integrator.wavelengths.0,
         sampler: r.integrator.sampler,
         equiangular: r.integrator.equiangular,
+        filter: r.filter,
     };
     let camera_path = scene.animation.as_ref().map(|a| CameraPath {
         fps: a.fps,

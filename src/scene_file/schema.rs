@@ -39,6 +39,9 @@ pub struct Render {
     pub seed: u64,
     #[serde(default)]
     pub integrator: IntegratorSettings,
+    /// The pixel filter camera samples are drawn from.
+    #[serde(default)]
+    pub filter: Filter,
     /// Overrides every surface of revolution's Newton tolerance (for accuracy studies).
     #[serde(default)]
     pub newton_tolerance: Option<Positive>,
@@ -69,6 +72,7 @@ impl Default for Render {
             max_depth: default_max_depth(),
             seed: default_seed(),
             integrator: IntegratorSettings::default(),
+            filter: Filter::default(),
             newton_tolerance: None,
         }
     }
@@ -124,6 +128,16 @@ pub enum LightSampling {
     #[default]
     Nee,
     Path,
+}
+
+/// The pixel filter, importance-sampled (each camera sample has weight one, nothing is
+/// splatted): a tent of radius one pixel, or a box of one pixel (what renderers that filter
+/// with a box use, for equal-error comparisons).
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
+pub enum Filter {
+    #[default]
+    Tent,
+    Box,
 }
 
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
