@@ -3,7 +3,7 @@
 
 mod common;
 use common::render::scene_file;
-use glam::{Vec2, Vec3};
+use glam::{Vec2, Vec3, Vec3Swizzles};
 use prism::integrator::Ctx;
 use prism::integrator::path::{camera_ray, camera_rays};
 use prism::integrator::transport::Rgb;
@@ -297,6 +297,174 @@ fn lane_camera_rays_are_the_scalar_camera_rays() {
             for (k, (g, w)) in got.iter().zip(&want).enumerate() {
                 assert_eq!(g, w, "{name} {} at {:?}", lanes.describe(), samples[k]);
             }
+        }
+    }
+}
+
+/// Rays for the intersection tests: random ones through a region around the shapes, and the
+/// hard cases (axis-parallel rays on slab planes, rays along a plane, tangent and grazing
+/// rays, origins on the surface, zero and tiny t_max).
+fn test_rays() -> Vec<([f32; 3], [f32; 3], f32)> {
+    let mut g = SplitMix(34);
+    let unit = |g: &mut SplitMix| {
+        let v = Vec3::new(
+            g.range(-1.0, 1.0) as f32,
+            g.range(-1.0, 1.0) as f32,
+            g.range(-1.0, 1.0) as f32,
+        );
+        v.normalize_or(Vec3::X)
+    };
+    let mut rays = Vec::new();
+    for k in 0..20_000 {
+        let o = Vec3::new(
+            g.range(-3.0, 3.0) as f32,
+            g.range(-3.0, 3.0) as f32,
+            g.range(-3.0, 3.0) as f32,
+        );
+        // Half aimed near the origin, where the shapes are.
+        let d = if k % 2 == 0 {
+            (unit(&mut g) * 0.8 - o).normalize()
+        } else {
+            unit(&mut g)
+        };
+        let t_max = if k % 7 == 0 {
+            g.range(0.0, 3.0) as f32
+        } else {
+            f32::INFINITY
+        };
+        rays.push((o.to_array(), d.to_array(), t_max));
+    }
+    for axis in [Vec3::X, Vec3::Y, Vec3::Z] {
+        for s in [-1.0f32, 1.0] {
+            // On the unit slab planes and tangent to the unit sphere.
+            rays.push((
+                (axis * s + axis.zxy() * -3.0).to_array(),
+                axis.zxy().to_array(),
+                f32::INFINITY,
+            ));
+            rays.push(((axis * s).to_array(), (axis * -s).to_array(), f32::INFINITY));
+            rays.push(((axis * s).to_array(), (axis * s).to_array(), 0.0));
+            rays.push(((axis * 3.0 * s).to_array(), (axis * -s).to_array(), 1e-30));
+        }
+    }
+    rays.push(([0.0, 0.0, 0.0], [0.0, 0.0, 0.0], f32::INFINITY));
+    rays
+}
+
+struct Shapes<'a> {
+    rays: &'a [([f32; 3], [f32; 3], f32)],
+    sphere: prism::geometry::Sphere,
+    rect: prism::geometry::Planar,
+    boxed: prism::geometry::OrientedBox,
+}
+
+impl LaneKernel for Shapes<'_> {
+    type Output = Vec<Vec<u32>>;
+    #[inline(always)]
+    fn run<F: Float>(self) -> Vec<Vec<u32>> {
+        let r = self.rays;
+        chunks::<F, u32>(r.len(), |idx| {
+            let o = V3::<F>::from_fn(|l| Vec3::from(r[idx(l)].0));
+            let d = V3::<F>::from_fn(|l| Vec3::from(r[idx(l)].1));
+            let t_max = F::from_fn(|l| r[idx(l)].2);
+            let one = F::one();
+            let flag = |m: F::Mask| F::select(m, one, F::zero());
+            let (ts, hs, os) = self.sphere.intersect_lanes(o, d, t_max);
+            let (tr, ar, br, hr) = self.rect.intersect_lanes(o, d, t_max, false);
+            let (td, ad, bd, hd) = self.rect.intersect_lanes(o, d, t_max, true);
+            let (tb, hb, ob) = self.boxed.intersect_lanes(o, d, t_max);
+            // Only what a hit reports is compared: a miss's t is not part of the contract.
+            let keep = |m: F::Mask, v: F| F::select(m, v, F::zero());
+            bits_of(&[
+                flag(hs),
+                keep(hs, ts),
+                keep(hs, flag(os)),
+                flag(hr),
+                keep(hr, tr),
+                keep(hr, ar),
+                keep(hr, br),
+                flag(hd),
+                keep(hd, td),
+                keep(hd, ad),
+                keep(hd, bd),
+                flag(hb),
+                keep(hb, tb),
+                keep(hb, flag(ob)),
+            ])
+        })
+    }
+}
+
+#[test]
+fn lane_intersections_are_the_scalar_intersections() {
+    use prism::geometry::{OrientedBox, Planar, Ray, Sphere};
+    let sphere = Sphere {
+        center: Vec3::new(0.1, -0.2, 0.05),
+        radius: 1.0,
+    };
+    let rect = Planar::new(
+        Vec3::new(0.0, 0.3, 0.0),
+        Vec3::new(1.0, 0.0, 0.2),
+        Vec3::new(0.0, 0.1, -1.0),
+        false,
+    );
+    let boxed = OrientedBox::new(
+        Vec3::splat(-1.0),
+        Vec3::splat(1.0),
+        glam::Affine3A::from_scale_rotation_translation(
+            Vec3::new(1.0, 0.5, 2.0),
+            glam::Quat::from_rotation_y(0.4) * glam::Quat::from_rotation_x(-0.3),
+            Vec3::new(0.2, 0.0, -0.1),
+        ),
+    );
+    let rays = test_rays();
+    let mut hits = [0usize; 4];
+    let want: Vec<Vec<u32>> = rays
+        .iter()
+        .map(|&(o, d, t_max)| {
+            let ray = Ray::new(Vec3::from(o), Vec3::from(d));
+            let mut v = Vec::new();
+            let f = |b: bool| if b { 1.0f32 } else { 0.0 };
+            match sphere.intersect(&ray, t_max) {
+                Some((t, out)) => {
+                    hits[0] += 1;
+                    v.extend([1.0, t, f(out)]);
+                }
+                None => v.extend([0.0; 3]),
+            }
+            for (i, disk) in [(1, false), (2, true)] {
+                match rect.intersect(&ray, t_max, disk) {
+                    Some((t, a, b)) => {
+                        hits[i] += 1;
+                        v.extend([1.0, t, a, b]);
+                    }
+                    None => v.extend([0.0; 4]),
+                }
+            }
+            match boxed.intersect(&ray, t_max) {
+                Some((t, out)) => {
+                    hits[3] += 1;
+                    v.extend([1.0, t, f(out)]);
+                }
+                None => v.extend([0.0; 3]),
+            }
+            v.iter().map(|x| x.to_bits()).collect()
+        })
+        .collect();
+    // The rays really exercise every shape.
+    assert!(hits.iter().all(|&h| h > 1000), "hits per shape {hits:?}");
+    for lanes in forms() {
+        let got = simd::dispatch(
+            lanes,
+            Shapes {
+                rays: &rays,
+                sphere,
+                rect,
+                boxed,
+            },
+        );
+        for (k, (g, w)) in got.iter().zip(&want).enumerate() {
+            assert_eq!(g, w, "{} at {:?}", lanes.describe(), rays[k]);
         }
     }
 }

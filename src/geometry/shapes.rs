@@ -3,6 +3,7 @@
 //! its pdf beside it.
 
 use super::{Aabb, Ray};
+use crate::simd::{Float, V3};
 use glam::{Affine3A, Mat3, Vec2, Vec3};
 
 /// Where on a surface a ray hit, and the frame there.
@@ -43,6 +44,26 @@ pub struct ShapeSample {
     pub pdf: f32,
 }
 
+/// Dot product without fused multiply-adds: intersection runs in the per-ray kd-tree walk,
+/// outside the lane entry points, where a `mul_add` would be a call into `fmaf`.
+#[inline(always)]
+fn dot<F: Float>(a: V3<F>, b: V3<F>) -> F {
+    a.x * b.x + a.y * b.y + a.z * b.z
+}
+
+/// IEEE minNum, as `f32::min`: a NaN operand gives the other one.
+#[inline(always)]
+fn min_num<F: Float>(a: F, b: F) -> F {
+    // The SSE rule already returns `b` when `a` is NaN.
+    F::select(b.is_nan(), a, a.min(b))
+}
+
+/// IEEE maxNum, as `f32::max`.
+#[inline(always)]
+fn max_num<F: Float>(a: F, b: F) -> F {
+    F::select(b.is_nan(), a, a.max(b))
+}
+
 /// Bounds padding: the relative error of a few float operations on the coordinates, so the
 /// kd-tree never culls a hit the exact surface has.
 const PAD_REL: f32 = 4.0 * f32::EPSILON;
@@ -78,28 +99,30 @@ impl Sphere {
     /// Also says whether the ray starts outside (so meets the outer side).
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<(f32, bool)> {
-        let f = ray.o - self.center;
-        let a = ray.d.length_squared();
-        let b = f.dot(ray.d);
-        let c = f.length_squared() - self.radius * self.radius;
-        let l = f - (b / a) * ray.d;
-        let disc = a * (self.radius * self.radius - l.length_squared());
-        if disc < 0.0 {
-            return None;
-        }
-        let q = -b - b.signum() * disc.sqrt();
-        let (mut t0, mut t1) = (c / q, q / a);
-        if t0 > t1 {
-            std::mem::swap(&mut t0, &mut t1);
-        }
-        let outside = c > 0.0;
-        if t0 > 0.0 && t0 < t_max {
-            Some((t0, outside))
-        } else if t1 > 0.0 && t1 < t_max {
-            Some((t1, outside))
-        } else {
-            None
-        }
+        let (t, hit, outside) = self.intersect_lanes::<f32>(ray.o.into(), ray.d.into(), t_max);
+        hit.then_some((t, outside))
+    }
+
+    /// [`Sphere::intersect`] of one ray per lane: `(t, hit, outside)`.
+    #[inline(always)]
+    pub fn intersect_lanes<F: Float>(&self, o: V3<F>, d: V3<F>, t_max: F) -> (F, F::Mask, F::Mask) {
+        let zero = F::zero();
+        let r2 = F::splat(self.radius * self.radius);
+        let f = o - V3::splat(self.center);
+        let a = dot(d, d);
+        let b = dot(f, d);
+        let c = dot(f, f) - r2;
+        let l = f - d * (b / a);
+        let disc = a * (r2 - dot(l, l));
+        let q = -b - F::one().copysign(b) * disc.sqrt();
+        let (ra, rb) = (c / q, q / a);
+        let (t0, t1) = (ra.min(rb), ra.max(rb));
+        let outside = c.gt(zero);
+        let first = t0.gt(zero) & t0.lt(t_max);
+        let second = t1.gt(zero) & t1.lt(t_max);
+        // A negative discriminant gives NaN roots, which fail both tests.
+        let hit = disc.ge(zero) & (first | second);
+        (F::select(first, t0, t1), hit, outside)
     }
 
     #[inline]
@@ -210,21 +233,34 @@ impl Planar {
     /// Nearest hit in (0, t_max) with its (α, β) coordinates.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32, disk: bool) -> Option<(f32, f32, f32)> {
-        let denom = self.n.dot(ray.d);
-        let t = self.n.dot(self.center - ray.o) / denom;
-        // A ray in the plane (denom 0) gives an infinite or NaN t and fails here.
-        if !(t > 0.0 && t < t_max) {
-            return None;
-        }
-        let rel = ray.at(t) - self.center;
-        let a = self.w.dot(rel.cross(self.v));
-        let b = self.w.dot(self.u.cross(rel));
+        let (t, a, b, hit) = self.intersect_lanes::<f32>(ray.o.into(), ray.d.into(), t_max, disk);
+        hit.then_some((t, a, b))
+    }
+
+    /// [`Planar::intersect`] of one ray per lane: `(t, α, β, hit)`.
+    #[inline(always)]
+    pub fn intersect_lanes<F: Float>(
+        &self,
+        o: V3<F>,
+        d: V3<F>,
+        t_max: F,
+        disk: bool,
+    ) -> (F, F, F, F::Mask) {
+        let (n, c) = (V3::splat(self.n), V3::splat(self.center));
+        let (u, v, w) = (V3::splat(self.u), V3::splat(self.v), V3::splat(self.w));
+        let t = dot(n, c - o) / dot(n, d);
+        // A ray in the plane (denominator 0) gives an infinite or NaN t and fails here.
+        let in_range = t.gt(F::zero()) & t.lt(t_max);
+        let rel = o + d * t - c;
+        let a = dot(w, rel.cross(v));
+        let b = dot(w, u.cross(rel));
+        let one = F::one();
         let inside = if disk {
-            a * a + b * b <= 1.0
+            (a * a + b * b).le(one)
         } else {
-            a.abs() <= 1.0 && b.abs() <= 1.0
+            a.abs().le(one) & b.abs().le(one)
         };
-        inside.then_some((t, a, b))
+        (t, a, b, in_range & inside)
     }
 
     /// (α, β) of a point in the plane.
@@ -317,25 +353,42 @@ impl OrientedBox {
     /// Also says whether the ray starts outside the box.
     #[inline]
     pub fn intersect(&self, ray: &Ray, t_max: f32) -> Option<(f32, bool)> {
-        let r = self.object_ray(ray);
-        let inv = r.d.recip();
-        let t0 = (self.min - r.o) * inv;
-        let t1 = (self.max - r.o) * inv;
-        let tn = t0.min(t1);
-        let tf = t0.max(t1);
-        // NaN from 0·∞ (an axis-parallel ray on a slab plane) is dropped by max/min.
-        let t_near = tn.x.max(tn.y).max(tn.z);
-        let t_far = tf.x.min(tf.y).min(tf.z);
-        if t_near > t_far {
-            return None;
-        }
-        if t_near > 0.0 && t_near < t_max {
-            Some((t_near, true))
-        } else if t_near <= 0.0 && t_far > 0.0 && t_far < t_max {
-            Some((t_far, false))
-        } else {
-            None
-        }
+        let (t, hit, outside) = self.intersect_lanes::<f32>(ray.o.into(), ray.d.into(), t_max);
+        hit.then_some((t, outside))
+    }
+
+    /// [`OrientedBox::intersect`] of one ray per lane: `(t, hit, outside)`.
+    #[inline(always)]
+    pub fn intersect_lanes<F: Float>(&self, o: V3<F>, d: V3<F>, t_max: F) -> (F, F::Mask, F::Mask) {
+        let m = &self.to_object.matrix3;
+        let (mx, my, mz) = (
+            V3::splat(m.x_axis.into()),
+            V3::splat(m.y_axis.into()),
+            V3::splat(m.z_axis.into()),
+        );
+        let ro = mx * o.x + my * o.y + mz * o.z + V3::splat(self.to_object.translation.into());
+        let rd = mx * d.x + my * d.y + mz * d.z;
+        let inv = V3::new(rd.x.recip(), rd.y.recip(), rd.z.recip());
+        let t0 = (V3::splat(self.min) - ro).mul_elem(inv);
+        let t1 = (V3::splat(self.max) - ro).mul_elem(inv);
+        // NaN from 0·∞ (an axis-parallel ray on a slab plane) is dropped by these min/max.
+        let t_near = max_num(
+            max_num(min_num(t0.x, t1.x), min_num(t0.y, t1.y)),
+            min_num(t0.z, t1.z),
+        );
+        let t_far = min_num(
+            min_num(max_num(t0.x, t1.x), max_num(t0.y, t1.y)),
+            max_num(t0.z, t1.z),
+        );
+        let zero = F::zero();
+        let overlap = t_near.le(t_far);
+        let enter = t_near.gt(zero) & t_near.lt(t_max);
+        let leave = t_near.le(zero) & t_far.gt(zero) & t_far.lt(t_max);
+        (
+            F::select(enter, t_near, t_far),
+            overlap & (enter | leave),
+            enter,
+        )
     }
 
     /// Planar UVs on the face that was hit, over [0, 1]², with world-space derivatives.
