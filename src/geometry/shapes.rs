@@ -3,7 +3,7 @@
 //! its pdf beside it.
 
 use super::{Aabb, Ray};
-use crate::simd::{Float, V3};
+use crate::simd::{Float, Mask, V3};
 use glam::{Affine3A, Mat3, Vec2, Vec3};
 
 /// Where on a surface a ray hit, and the frame there.
@@ -114,6 +114,11 @@ impl Sphere {
         let c = dot(f, f) - r2;
         let l = f - d * (b / a);
         let disc = a * (r2 - dot(l, l));
+        // Most rays a leaf tests miss: skip the square root and divisions when all lanes do.
+        let real = disc.ge(zero);
+        if real.none() {
+            return (disc, real, real);
+        }
         let q = -b - F::one().copysign(b) * disc.sqrt();
         let (ra, rb) = (c / q, q / a);
         let (t0, t1) = (ra.min(rb), ra.max(rb));
@@ -121,7 +126,7 @@ impl Sphere {
         let first = t0.gt(zero) & t0.lt(t_max);
         let second = t1.gt(zero) & t1.lt(t_max);
         // A negative discriminant gives NaN roots, which fail both tests.
-        let hit = disc.ge(zero) & (first | second);
+        let hit = real & (first | second);
         (F::select(first, t0, t1), hit, outside)
     }
 
@@ -251,6 +256,9 @@ impl Planar {
         let t = dot(n, c - o) / dot(n, d);
         // A ray in the plane (denominator 0) gives an infinite or NaN t and fails here.
         let in_range = t.gt(F::zero()) & t.lt(t_max);
+        if in_range.none() {
+            return (t, t, t, in_range);
+        }
         let rel = o + d * t - c;
         let a = dot(w, rel.cross(v));
         let b = dot(w, u.cross(rel));
@@ -360,14 +368,25 @@ impl OrientedBox {
     /// [`OrientedBox::intersect`] of one ray per lane: `(t, hit, outside)`.
     #[inline(always)]
     pub fn intersect_lanes<F: Float>(&self, o: V3<F>, d: V3<F>, t_max: F) -> (F, F::Mask, F::Mask) {
-        let m = &self.to_object.matrix3;
-        let (mx, my, mz) = (
-            V3::splat(m.x_axis.into()),
-            V3::splat(m.y_axis.into()),
-            V3::splat(m.z_axis.into()),
-        );
-        let ro = mx * o.x + my * o.y + mz * o.z + V3::splat(self.to_object.translation.into());
-        let rd = mx * d.x + my * d.y + mz * d.z;
+        let (ro, rd) = if F::WIDTH == 1 {
+            // One ray: glam's 3-wide SIMD transform, the same operations in the same order
+            // as the lane form below (so the same bits), in a third of the instructions.
+            (
+                V3::splat(self.to_object.transform_point3(o.lane(0))),
+                V3::splat(self.to_object.transform_vector3(d.lane(0))),
+            )
+        } else {
+            let m = &self.to_object.matrix3;
+            let (mx, my, mz) = (
+                V3::splat(m.x_axis.into()),
+                V3::splat(m.y_axis.into()),
+                V3::splat(m.z_axis.into()),
+            );
+            (
+                mx * o.x + my * o.y + mz * o.z + V3::splat(self.to_object.translation.into()),
+                mx * d.x + my * d.y + mz * d.z,
+            )
+        };
         let inv = V3::new(rd.x.recip(), rd.y.recip(), rd.z.recip());
         let t0 = (V3::splat(self.min) - ro).mul_elem(inv);
         let t1 = (V3::splat(self.max) - ro).mul_elem(inv);
@@ -382,6 +401,9 @@ impl OrientedBox {
         );
         let zero = F::zero();
         let overlap = t_near.le(t_far);
+        if overlap.none() {
+            return (t_near, overlap, overlap);
+        }
         let enter = t_near.gt(zero) & t_near.lt(t_max);
         let leave = t_near.le(zero) & t_far.gt(zero) & t_far.lt(t_max);
         (

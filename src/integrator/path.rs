@@ -609,7 +609,7 @@ struct Segment {
 /// non-zero (where (b) is the only one, `w_b = 1`), so the sum is unbiased. Every factor is
 /// known at each technique's sample, and (b)'s weight does not involve (c), so emitters hit
 /// by chance need nothing about the segment they were reached from.
-#[inline(always)]
+#[inline]
 fn equiangular_nee<T: Transport, const MOTION: bool>(
     ctx: &Ctx,
     s: &PathState<T>,
@@ -705,7 +705,7 @@ fn shadow_ray_to_area(p: Vec3, q: Vec3, nq: Vec3) -> Ray {
 /// A scattering event inside a medium: next-event estimation through the phase function
 /// (MIS with phase sampling and with the equiangular technique, see [`equiangular_nee`]),
 /// then a phase-sampled continuation.
-#[inline(always)]
+#[inline]
 fn scatter_in_medium<T: Transport, const MOTION: bool>(
     ctx: &Ctx,
     s: &mut PathState<T>,

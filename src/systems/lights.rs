@@ -65,7 +65,7 @@ impl Lights {
 
     /// Chooses a light by power and samples a direction to it from `p`. A moving emitter is
     /// sampled in its rest pose at `time` (a rigid map keeps solid-angle densities).
-    #[inline(always)]
+    #[inline]
     pub fn sample<const MOTION: bool>(
         &self,
         prims: &Primitives,
