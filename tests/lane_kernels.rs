@@ -1,5 +1,7 @@
-//! The sampler, the warps and camera rays over lanes: every width and form gives, lane for
-//! lane, the bits of the scalar functions, which are the same code at width 1.
+//! The sampler, the warps, camera rays and shape intersection over lanes: every width and form
+//! gives, lane for lane, the bits of the scalar functions. For the sampler, warps and camera
+//! those are the same code at width 1; the shapes' scalar intersection is separate (faster)
+//! code, held to the same bits here.
 
 mod common;
 use common::render::scene_file;
