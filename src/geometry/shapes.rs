@@ -424,25 +424,15 @@ impl OrientedBox {
     /// [`OrientedBox::intersect`] of one ray per lane: `(t, hit, outside)`.
     #[inline(always)]
     pub fn intersect_lanes<F: Float>(&self, o: V3<F>, d: V3<F>, t_max: F) -> (F, F::Mask, F::Mask) {
-        let (ro, rd) = if F::WIDTH == 1 {
-            // One ray: glam's 3-wide SIMD transform, the same operations in the same order
-            // as the lane form below (so the same bits), in a third of the instructions.
-            (
-                V3::splat(self.to_object.transform_point3(o.lane(0))),
-                V3::splat(self.to_object.transform_vector3(d.lane(0))),
-            )
-        } else {
-            let m = &self.to_object.matrix3;
-            let (mx, my, mz) = (
-                V3::splat(m.x_axis.into()),
-                V3::splat(m.y_axis.into()),
-                V3::splat(m.z_axis.into()),
-            );
-            (
-                mx * o.x + my * o.y + mz * o.z + V3::splat(self.to_object.translation.into()),
-                mx * d.x + my * d.y + mz * d.z,
-            )
-        };
+        let m = &self.to_object.matrix3;
+        let (mx, my, mz) = (
+            V3::splat(m.x_axis.into()),
+            V3::splat(m.y_axis.into()),
+            V3::splat(m.z_axis.into()),
+        );
+        // glam's order of operations, so the scalar code's bits.
+        let ro = mx * o.x + my * o.y + mz * o.z + V3::splat(self.to_object.translation.into());
+        let rd = mx * d.x + my * d.y + mz * d.z;
         let inv = V3::new(rd.x.recip(), rd.y.recip(), rd.z.recip());
         let t0 = (V3::splat(self.min) - ro).mul_elem(inv);
         let t1 = (V3::splat(self.max) - ro).mul_elem(inv);

@@ -150,8 +150,6 @@ pub struct Diffuse<S> {
 }
 
 impl<S> Diffuse<S> {
-    pub const LOBES: u32 = lobe::DIFFUSE_REFLECTION;
-
     /// Cosine-weighted: the weight is the albedo itself.
     #[inline(always)]
     pub fn sample<F: Float>(&self, _wo: V3<F>, ux: F, uy: F) -> BsdfSample<F, S>
@@ -195,8 +193,6 @@ pub struct Mirror<S> {
 }
 
 impl<S> Mirror<S> {
-    pub const LOBES: u32 = lobe::SPECULAR_REFLECTION;
-
     #[inline(always)]
     pub fn sample<F: Float>(&self, wo: V3<F>) -> BsdfSample<F, S>
     where
@@ -236,8 +232,6 @@ pub struct Dielectric<F> {
 }
 
 impl<F: Float> Dielectric<F> {
-    pub const LOBES: u32 = lobe::SPECULAR;
-
     /// Fresnel reflectance for `wo` (the incident direction reversed).
     #[inline(always)]
     pub fn reflectance(&self, wo: V3<F>) -> F {

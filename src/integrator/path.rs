@@ -200,19 +200,25 @@ pub fn camera_rays<F: Float, const MOTION: bool>(
             .camera_path
             .as_ref()
             .expect("camera_moves implies a path");
-        let mut frames = [scene.camera; 16];
-        for (i, f) in frames.iter_mut().enumerate().take(F::WIDTH) {
-            *f = path
-                .at(time.lane(i), &scene.base_camera)
-                .frame(s.width, s.height);
-        }
-        FrameLanes {
-            origin: V3::from_fn(|i| frames[i].origin),
-            forward: V3::from_fn(|i| frames[i].forward),
-            right: V3::from_fn(|i| frames[i].right),
-            up: V3::from_fn(|i| frames[i].up),
-            half_x: F::from_fn(|i| frames[i].half.x),
-            half_y: F::from_fn(|i| frames[i].half.y),
+        let at = |i: usize| {
+            path.at(time.lane(i), &scene.base_camera)
+                .frame(s.width, s.height)
+        };
+        if F::WIDTH == 1 {
+            FrameLanes::splat(&at(0))
+        } else {
+            let mut frames = [scene.camera; 16];
+            for (i, f) in frames.iter_mut().enumerate().take(F::WIDTH) {
+                *f = at(i);
+            }
+            FrameLanes {
+                origin: V3::from_fn(|i| frames[i].origin),
+                forward: V3::from_fn(|i| frames[i].forward),
+                right: V3::from_fn(|i| frames[i].right),
+                up: V3::from_fn(|i| frames[i].up),
+                half_x: F::from_fn(|i| frames[i].half.x),
+                half_y: F::from_fn(|i| frames[i].half.y),
+            }
         }
     } else {
         FrameLanes::splat(&scene.camera)
