@@ -42,6 +42,7 @@ fn wavefront(spp: u32) -> RenderOptions {
         spp,
         time_limit: None,
         integrator: Integrator::Wavefront,
+        lanes: prism::simd::Lanes::auto(),
     }
 }
 
@@ -141,6 +142,7 @@ fn integrator(c: &mut Criterion) {
             spp: 4,
             time_limit: None,
             integrator,
+            lanes: prism::simd::Lanes::auto(),
         };
         g.bench_function(format!("cornell_64x64_4spp_{name}"), |b| {
             b.iter(|| render(&scene, &opts, &|_| {}).stats.samples)

@@ -234,3 +234,72 @@ fn merge_refuses_parts_that_do_not_belong_together() {
     assert!(merge("a.exr", "a.png").contains("header"));
     assert!(!p("m.exr").exists());
 }
+
+#[test]
+fn parts_record_their_lane_width_and_merge_refuses_mixed_widths() {
+    let (d, scene) = setup();
+    let s = scene.to_str().unwrap();
+    let p = |n: &str| d.path().join(n);
+    exr(s, 4, 0, &p("w1.exr"), &["--simd", "1"]);
+    exr(s, 4, 4, &p("auto.exr"), &["--simd", "auto"]);
+    let width = |n: &str| prism::film::read_image(&p(n)).unwrap().1.unwrap().simd;
+    let auto = prism::simd::Lanes::auto().width() as u32;
+    assert_eq!(width("w1.exr"), Some(1));
+    assert_eq!(width("auto.exr"), Some(auto));
+    let merge = |x: &str, y: &str| {
+        prism()
+            .arg("merge")
+            .arg(p(x))
+            .arg(p(y))
+            .arg("-o")
+            .arg(p("m.exr"))
+            .output()
+            .unwrap()
+    };
+    if auto == 1 {
+        println!("this CPU runs width 1 only: mixed widths not tested");
+    } else {
+        let out = merge("w1.exr", "auto.exr");
+        assert!(!out.status.success());
+        let e = String::from_utf8_lossy(&out.stderr);
+        assert!(e.contains("lane width") && e.contains("--simd"), "{e}");
+    }
+    exr(s, 4, 4, &p("w1b.exr"), &["--simd", "1"]);
+    assert!(merge("w1.exr", "w1b.exr").status.success());
+    assert_eq!(width("m.exr"), Some(1));
+}
+
+#[test]
+fn a_width_the_cpu_lacks_or_does_not_know_is_refused_in_one_line() {
+    let (d, scene) = setup();
+    let s = scene.to_str().unwrap();
+    let out = d.path().join("x.exr");
+    let run = |args: &[&str]| {
+        prism()
+            .args(["render", s, "--quiet", "--spp", "1", "-o"])
+            .arg(&out)
+            .args(args)
+            .output()
+            .unwrap()
+    };
+    for (w, native) in [
+        ("16", prism::simd::Lanes::native16()),
+        ("8", prism::simd::Lanes::native8()),
+    ] {
+        let o = run(&["--simd", w]);
+        if native.is_some() {
+            assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+        } else {
+            let e = String::from_utf8_lossy(&o.stderr);
+            assert!(!o.status.success());
+            assert_eq!(e.trim_end().lines().count(), 1, "{e}");
+            assert!(e.contains(&format!("--simd {w} needs")), "{e}");
+        }
+    }
+    assert!(fails(prism().args(["render", s, "--simd", "4"])).contains("auto, 16, 8 or 1"));
+    assert!(
+        fails(prism().args(["render", s, "--set", "render.simd=4"])).contains("auto, 16, 8 or 1")
+    );
+    assert!(run(&["--set", "render.simd=auto"]).status.success());
+    assert!(run(&["--set", "render.simd=1"]).status.success());
+}

@@ -470,3 +470,72 @@ fn lane_intersections_are_the_scalar_intersections() {
         }
     }
 }
+
+struct OffsetKernel<'a>(&'a [(Vec3, Vec3)]);
+
+impl LaneKernel for OffsetKernel<'_> {
+    type Output = Vec<Vec<u32>>;
+    #[inline(always)]
+    fn run<F: Float>(self) -> Vec<Vec<u32>> {
+        let a = self.0;
+        chunks::<F, u32>(a.len(), |idx| {
+            let p = V3::<F>::from_fn(|l| a[idx(l)].0);
+            let n = V3::<F>::from_fn(|l| a[idx(l)].1);
+            let o = prism::geometry::offset_ray_origin_lanes(p, n);
+            bits_of(&[o.x, o.y, o.z])
+        })
+    }
+}
+
+/// The packet kernel spawns rays with the lane form of the robust offset: the same bits as the
+/// scalar one, at every magnitude (near the origin, where the absolute offset takes over; at
+/// ±0; at huge coordinates; on either side of zero).
+#[test]
+fn lane_ray_offsets_are_the_scalar_offsets() {
+    let mut g = SplitMix(77);
+    let special = [
+        0.0f32,
+        -0.0,
+        1e-30,
+        -1e-30,
+        0.03,
+        -0.03,
+        1.0 / 32.0,
+        1e30,
+        -1e30,
+        3.4e38,
+    ];
+    let mut a = Vec::new();
+    for &x in &special {
+        for &y in &special {
+            let n = Vec3::new(g.range(-1.0, 1.0) as f32, 1.0, g.range(-1.0, 1.0) as f32);
+            a.push((Vec3::new(x, y, -x), n.normalize()));
+        }
+    }
+    for _ in 0..20_000 {
+        let scale = 10f64.powf(g.range(-6.0, 6.0)) as f32;
+        let p = Vec3::new(
+            g.range(-1.0, 1.0) as f32,
+            g.range(-1.0, 1.0) as f32,
+            g.range(-1.0, 1.0) as f32,
+        ) * scale;
+        let n = prism::sampling::square_to_uniform_sphere(Vec2::new(
+            g.range(0.0, 1.0) as f32,
+            g.range(0.0, 1.0) as f32,
+        ));
+        a.push((p, n));
+    }
+    let want: Vec<Vec<u32>> = a
+        .iter()
+        .map(|&(p, n)| {
+            let o = prism::geometry::offset_ray_origin(p, n);
+            vec![o.x.to_bits(), o.y.to_bits(), o.z.to_bits()]
+        })
+        .collect();
+    for lanes in forms() {
+        let got = simd::dispatch(lanes, OffsetKernel(&a));
+        for (k, (g, w)) in got.iter().zip(&want).enumerate() {
+            assert_eq!(g, w, "{} at {:?}", lanes.describe(), a[k]);
+        }
+    }
+}

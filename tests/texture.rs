@@ -302,6 +302,7 @@ fn float_sources_are_linear_in_either_space() {
         spp: 1,
         sample_offset: 0,
         scene_hash: 0,
+        simd: None,
     };
     write_image(&exr, &film, &meta, &PngOptions::default()).unwrap();
     let hdr = dir.path().join("t.hdr");

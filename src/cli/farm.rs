@@ -78,6 +78,15 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<(u32, u64), CliError> {
                     meta.scene_hash
                 )));
             }
+            if let (Some(w0), Some(w)) = (m0.simd, meta.simd)
+                && w0 != w
+            {
+                return Err(CliError(format!(
+                    "'{}' was rendered at lane width {w0} but '{}' at {w}: widths round differently, so render every part with the same --simd",
+                    p0.display(),
+                    p.display(),
+                )));
+            }
             if (i0.width, i0.height) != (img.width, img.height) {
                 return Err(CliError(format!(
                     "'{}' is {}x{} but '{}' is {}x{}",
@@ -146,6 +155,7 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<(u32, u64), CliError> {
         spp: total_u32,
         sample_offset: ranges[0].0,
         scene_hash: loaded[0].2.scene_hash,
+        simd: loaded[0].2.simd,
     };
     film::write_image(out, &merged, &meta, &PngOptions::default())?;
     Ok((total_u32, ranges[0].0))

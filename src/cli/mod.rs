@@ -108,6 +108,10 @@ pub struct RenderArgs {
     /// The number of shards N for --shard-from-env.
     #[arg(long, requires = "shard_from_env")]
     pub shard_count: Option<u32>,
+    /// Lane width: auto (the widest this CPU runs natively), 16 (AVX-512), 8 (AVX2) or 1.
+    /// Overrides render.simd. Pin it on a farm: widths round differently.
+    #[arg(long)]
+    pub simd: Option<crate::simd::SimdChoice>,
     /// Use the per-path reference integrator instead of the wavefront one.
     #[arg(long, hide = true)]
     pub reference: bool,
@@ -401,6 +405,8 @@ fn render_to_file(
     label: &str,
 ) -> Result<integrator::RenderOutput, CliError> {
     let spp = rs.settings.spp;
+    let lanes = crate::simd::Lanes::resolve(a.simd.unwrap_or(rs.settings.simd))
+        .map_err(|e| CliError(e.to_string()))?;
     let opts = RenderOptions {
         sample_offset: a.sample_offset,
         spp,
@@ -410,6 +416,7 @@ fn render_to_file(
         } else {
             Integrator::Wavefront
         },
+        lanes,
     };
     let total = rs.settings.width as u64 * rs.settings.height as u64 * spp as u64;
     let bar = progress::Progress::new(total, a.quiet, label);
@@ -419,6 +426,7 @@ fn render_to_file(
         spp: out.spp,
         sample_offset: a.sample_offset as u64,
         scene_hash: scene.hash,
+        simd: Some(out.lanes.width() as u32),
     };
     film::write_image(
         output,
@@ -524,6 +532,15 @@ fn print_stats(rs: &RenderScene, out: &integrator::RenderOutput, output: &Path, 
         sps / threads as f64
     );
     eprintln!("dropped samples: {}", s.dropped);
+    if s.lane_slots > 0 {
+        eprintln!(
+            "simd: width {}, mean lane occupancy {:.3}",
+            out.lanes.describe(),
+            s.rays as f64 / s.lane_slots as f64
+        );
+    } else {
+        eprintln!("simd: width {}", out.lanes.describe());
+    }
     eprintln!(
         "rays: {} closest-hit, {} shadow ({:.2} Mrays/s)",
         s.rays,
@@ -571,6 +588,10 @@ fn info(a: InfoArgs) -> Result<(), CliError> {
         s.sampler,
         s.filter
     );
+    match crate::simd::Lanes::resolve(s.simd) {
+        Ok(lanes) => println!("simd: {}", integrator::describe_lanes(&rs, lanes)),
+        Err(e) => println!("simd: {e}"),
+    }
     println!("entities: {}", rs.prims.len());
     for i in 0..rs.prims.len() {
         let m = rs.prims.materials[rs.prims.material[i] as usize];

@@ -243,6 +243,7 @@ mod tests {
             spp: 1,
             sample_offset: 0,
             scene_hash: 0,
+            simd: None,
         };
         let opts = PngOptions::default();
         write_image(&pa, &Image::filled(64, 64, [0.0; 3]), &meta, &opts).unwrap();

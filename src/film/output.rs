@@ -59,6 +59,9 @@ pub struct ImageMeta {
     pub spp: u32,
     pub sample_offset: u64,
     pub scene_hash: u64,
+    /// The lane width the samples were computed at (`prism:simd`): widths round differently,
+    /// so parts of one image must agree on it. `None` when unknown.
+    pub simd: Option<u32>,
 }
 
 /// Header attribute names for [`ImageMeta`].
@@ -72,6 +75,8 @@ pub const ATTR_SPP: &str = "prism:spp";
 pub const ATTR_SAMPLE_OFFSET: &str = "prism:sample_offset";
 /// See [`ATTR_SPP`].
 pub const ATTR_SCENE_HASH: &str = "prism:scene_hash";
+/// The lane width, in decimal (optional: images from before it existed lack it).
+pub const ATTR_SIMD: &str = "prism:simd";
 
 /// Output formats `write_image` can produce.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -323,7 +328,10 @@ fn encode_exr(path: &Path, img: &Image, meta: &ImageMeta) -> Result<Vec<u8>, Fil
         (ATTR_SPP, meta.spp.to_string()),
         (ATTR_SAMPLE_OFFSET, meta.sample_offset.to_string()),
         (ATTR_SCENE_HASH, format!("{:#018x}", meta.scene_hash)),
-    ] {
+    ]
+    .into_iter()
+    .chain(meta.simd.map(|w| (ATTR_SIMD, w.to_string())))
+    {
         attributes.other.insert(
             ex::Text::from(name),
             ex::AttributeValue::Text(ex::Text::from(value.as_str())),
@@ -605,6 +613,7 @@ fn decode_exr(path: &Path, bytes: Vec<u8>) -> Result<(Image, Option<ImageMeta>),
             spp: text(ATTR_SPP)?.trim().parse().ok()?,
             sample_offset: text(ATTR_SAMPLE_OFFSET)?.trim().parse().ok()?,
             scene_hash: parse_hash(&text(ATTR_SCENE_HASH)?)?,
+            simd: text(ATTR_SIMD).and_then(|t| t.trim().parse().ok()),
         })
     })();
 
@@ -667,6 +676,7 @@ mod tests {
         spp: 4096,
         sample_offset: 1 << 40,
         scene_hash: 0xfedc_ba98_7654_3210,
+        simd: Some(16),
     };
 
     fn entries(dir: &Path) -> Vec<String> {
@@ -804,11 +814,13 @@ mod tests {
                 spp: 0,
                 sample_offset: 0,
                 scene_hash: 0,
+                simd: None,
             },
             ImageMeta {
                 spp: u32::MAX,
                 sample_offset: u64::MAX,
                 scene_hash: u64::MAX,
+                simd: Some(u32::MAX),
             },
         ] {
             write_image(

@@ -5,7 +5,7 @@ pub mod ray;
 pub mod shapes;
 
 pub use bounds::Aabb;
-pub use ray::{Ray, offset_ray_origin, spawn_ray, spawn_ray_to};
+pub use ray::{Ray, offset_ray_origin, offset_ray_origin_lanes, spawn_ray, spawn_ray_to};
 pub use shapes::{OrientedBox, Planar, ShapeSample, Sphere, SurfacePoint};
 pub mod motion;
 pub use motion::RigidMotion;

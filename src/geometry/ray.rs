@@ -1,5 +1,6 @@
 //! Rays and the robust offset used to spawn them from surfaces.
 
+use crate::simd::{Float, UInt, V3};
 use glam::Vec3;
 
 /// A ray `o + t d`. `d` need not be normalised: analytic shapes intersect in object space,
@@ -55,6 +56,32 @@ pub fn offset_ray_origin(p: Vec3, n: Vec3) -> Vec3 {
         pick(p.y, p_i.y, n.y),
         pick(p.z, p_i.z, n.z),
     )
+}
+
+/// [`offset_ray_origin`] over lanes, bit for bit.
+#[inline(always)]
+pub fn offset_ray_origin_lanes<F: Float>(p: V3<F>, n: V3<F>) -> V3<F> {
+    V3::new(
+        offset_lanes(p.x, n.x),
+        offset_lanes(p.y, n.y),
+        offset_lanes(p.z, n.z),
+    )
+}
+
+/// One coordinate of [`offset_ray_origin_lanes`] (a function, not a closure: closures are not
+/// forced inline, and one left out of line calls the intrinsics out of line).
+#[inline(always)]
+fn offset_lanes<F: Float>(p: F, n: F) -> F {
+    let oi = (n * F::splat(INT_SCALE)).to_i32_bits();
+    let bits = p.to_bits();
+    let neg = p.lt(F::zero());
+    let pi = F::from_bits(F::U32::select(
+        neg,
+        bits.wrapping_sub(oi),
+        bits.wrapping_add(oi),
+    ));
+    let small = p.abs().lt(F::splat(ORIGIN));
+    F::select(small, p + F::splat(FLOAT_SCALE) * n, pi)
 }
 
 /// Spawns a ray from surface point `p` (geometric normal `ng`) in direction `d`, offset to

@@ -6,6 +6,7 @@
 //! costs no branch per ray. LENS is a flag read once per render.
 
 pub mod bsdf;
+pub mod packet;
 pub mod path;
 pub mod reference;
 pub mod transport;
@@ -71,6 +72,9 @@ pub struct RenderStats {
     pub dropped: u64,
     pub rays: u64,
     pub shadow_rays: u64,
+    /// Lanes offered to paths by the packet kernel, one per lane per step (live or not):
+    /// `rays / lane_slots` is its mean lane occupancy. Zero for the per-path integrators.
+    pub lane_slots: u64,
 }
 
 impl RenderStats {
@@ -79,6 +83,7 @@ impl RenderStats {
         self.dropped += o.dropped;
         self.rays += o.rays;
         self.shadow_rays += o.shadow_rays;
+        self.lane_slots += o.lane_slots;
         self.revolution += o.revolution;
     }
 }
@@ -147,6 +152,9 @@ pub struct RenderOptions {
     /// Stop between whole passes once this many seconds are spent.
     pub time_limit: Option<f64>,
     pub integrator: Integrator,
+    /// The lane width asked for: the packet kernel runs at it where it covers the scene's
+    /// effects, the per-path integrator at width 1 elsewhere.
+    pub lanes: crate::simd::Lanes,
 }
 
 /// Linear per-pixel sums of a render and what it cost.
@@ -159,6 +167,8 @@ pub struct RenderOutput {
     pub spp: u32,
     pub stats: RenderStats,
     pub seconds: f64,
+    /// The lane width that ran.
+    pub lanes: crate::simd::Lanes,
 }
 
 impl RenderOutput {
@@ -204,11 +214,69 @@ pub fn render(
     }
 }
 
+/// The lane width a render runs at: `asked` where the packet kernel covers the scene's
+/// effects and the wavefront integrator was asked for, else width 1.
+pub fn lanes_for(
+    scene: &RenderScene,
+    integrator: Integrator,
+    asked: crate::simd::Lanes,
+) -> crate::simd::Lanes {
+    let fx = &scene.effects;
+    if integrator == Integrator::Wavefront
+        && asked.width() > 1
+        && packet::supports(fx.has(Effect::Spectral), fx.has(Effect::Media))
+    {
+        asked
+    } else {
+        crate::simd::Lanes::scalar()
+    }
+}
+
+/// What `lanes_for` decides, for `prism info`: the width and why.
+pub fn describe_lanes(scene: &RenderScene, asked: crate::simd::Lanes) -> String {
+    let ran = lanes_for(scene, Integrator::Wavefront, asked);
+    if ran == asked || asked.width() == 1 {
+        format!(
+            "{} (auto: {})",
+            ran.describe(),
+            crate::simd::Lanes::auto().describe()
+        )
+    } else {
+        format!(
+            "{}: the packet kernel does not cover SPECTRAL or MEDIA yet, so {} is not used",
+            ran.describe(),
+            asked.describe()
+        )
+    }
+}
+
+/// One tile's samples through the packet kernel, at the lane type `dispatch` picks.
+struct PacketTile<'a, 'c, const MOTION: bool> {
+    ctx: &'a Ctx<'c>,
+    tile: &'a Tile,
+    s0: u32,
+    s1: u32,
+    film: &'a mut [[f64; 3]],
+    stats: &'a mut RenderStats,
+}
+
+impl<const MOTION: bool> crate::simd::LaneKernel for PacketTile<'_, '_, MOTION> {
+    type Output = ();
+    #[inline(always)]
+    fn run<F: crate::simd::Float>(self) {
+        packet::render_tile::<F, MOTION>(
+            self.ctx, self.tile, self.s0, self.s1, self.film, self.stats,
+        )
+    }
+}
+
 fn render_with<T: WithQueues, const MEDIA: bool, const MOTION: bool>(
     scene: &RenderScene,
     opts: &RenderOptions,
     progress: &(dyn Fn(u64) + Sync),
 ) -> RenderOutput {
+    let lanes = lanes_for(scene, opts.integrator, opts.lanes);
+    let packet = lanes.width() > 1;
     let spectral = if scene.effects.has(Effect::Spectral) {
         transport::SpectralData::new(scene)
     } else {
@@ -240,6 +308,17 @@ fn render_with<T: WithQueues, const MEDIA: bool, const MOTION: bool>(
                 // Width 1 runs inside its entry point so the lane code it inlines (warps,
                 // BSDFs, camera rays, lane math) uses the CPU's FMA.
                 match opts.integrator {
+                    Integrator::Wavefront if packet => crate::simd::dispatch(
+                        lanes,
+                        PacketTile::<MOTION> {
+                            ctx: &ctx,
+                            tile,
+                            s0,
+                            s1: s0 + n,
+                            film: &mut film,
+                            stats: &mut st,
+                        },
+                    ),
                     Integrator::Wavefront => T::with_queues(|q| {
                         crate::simd::scalar_entry(
                             #[inline(always)]
@@ -303,5 +382,6 @@ fn render_with<T: WithQueues, const MEDIA: bool, const MOTION: bool>(
         spp: done,
         stats,
         seconds: start.elapsed().as_secs_f64(),
+        lanes,
     }
 }

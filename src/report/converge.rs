@@ -194,6 +194,7 @@ fn timed_render(
             spp,
             time_limit: None,
             integrator: Integrator::Wavefront,
+            lanes: crate::simd::Lanes::auto(),
         },
         &|_| {},
     );
@@ -249,6 +250,7 @@ fn reference(opts: &ConvergeOptions) -> Result<(Image, Option<f64>), String> {
         spp: 2 * half,
         sample_offset: 0,
         scene_hash: scene.hash,
+        simd: None,
     };
     film::write_image(&path, &img, &meta, &PngOptions::default()).map_err(|e| e.to_string())?;
     film::write_atomic(&note, format!("{est:e}\n").as_bytes()).map_err(|e| e.to_string())?;

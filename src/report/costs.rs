@@ -15,6 +15,7 @@ fn ns_per_sample(rs: &systems::RenderScene, spp: u32, runs: usize) -> f64 {
         spp,
         time_limit: None,
         integrator: Integrator::Wavefront,
+        lanes: crate::simd::Lanes::auto(),
     };
     let mut t: Vec<f64> = (0..runs)
         .map(|_| {

@@ -22,6 +22,7 @@ pub struct RenderSettings {
     pub sampler: schema::SamplerChoice,
     pub equiangular: bool,
     pub filter: schema::Filter,
+    pub simd: crate::simd::SimdChoice,
 }
 
 /// A loaded scene: the world of entities and the resources beside it.
@@ -116,6 +117,7 @@ pub const OVERRIDE_KEYS: &[&str] = &[
     "render.integrator.sampler",
     "render.integrator.equiangular",
     "render.filter",
+    "render.simd",
     "camera.position",
     "camera.look_at",
     "camera.up",
@@ -158,6 +160,13 @@ pub fn apply_override(scene: &mut schema::Scene, key: &str, value: &str) -> Resu
         "render.integrator.sampler" => r.integrator.sampler = val(key, value)?,
         "render.integrator.equiangular" => r.integrator.equiangular = val(key, value)?,
         "render.filter" => r.filter = val(key, value)?,
+        // `auto` as the CLI spells it, or a width.
+        "render.simd" => {
+            r.simd = value.parse().map_err(|message| SceneError::Override {
+                key: key.to_string(),
+                message,
+            })?
+        }
         "camera.position" => c.position = val(key, value)?,
         "camera.look_at" => c.look_at = val(key, value)?,
         "camera.up" => c.up = val(key, value)?,
@@ -239,6 +248,7 @@ fn build_world(scene: schema::Scene, path: &Path, hash: u64) -> Result<LoadedSce
         sampler: r.integrator.sampler,
         equiangular: r.integrator.equiangular,
         filter: r.filter,
+        simd: r.simd,
     };
     let camera_path = scene.animation.as_ref().map(|a| CameraPath {
         fps: a.fps,

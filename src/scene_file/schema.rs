@@ -42,6 +42,9 @@ pub struct Render {
     /// The pixel filter camera samples are drawn from.
     #[serde(default)]
     pub filter: Filter,
+    /// The lane width of the packet kernel: `"auto"`, 16, 8 or 1 (`--simd` overrides it).
+    #[serde(default)]
+    pub simd: crate::simd::SimdChoice,
     /// Overrides every surface of revolution's Newton tolerance (for accuracy studies).
     #[serde(default)]
     pub newton_tolerance: Option<Positive>,
@@ -73,6 +76,7 @@ impl Default for Render {
             seed: default_seed(),
             integrator: IntegratorSettings::default(),
             filter: Filter::default(),
+            simd: Default::default(),
             newton_tolerance: None,
         }
     }

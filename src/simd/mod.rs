@@ -269,8 +269,9 @@ pub trait UInt:
     }
 }
 
-/// The lane width a render asks for: `--simd auto|16|8|1`.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Default, serde::Deserialize, serde::Serialize)]
+/// The lane width a render asks for: `--simd auto|16|8|1`, `render: (simd: 8)` (or
+/// `"auto"`) in a scene, `--set render.simd=8` (or `auto`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum SimdChoice {
     /// The widest width this CPU runs natively (see [`Lanes::auto`]).
     #[default]
@@ -284,7 +285,7 @@ impl std::str::FromStr for SimdChoice {
     type Err = String;
     fn from_str(s: &str) -> Result<Self, String> {
         match s {
-            "auto" => Ok(SimdChoice::Auto),
+            "auto" | "Auto" => Ok(SimdChoice::Auto),
             "16" => Ok(SimdChoice::W16),
             "8" => Ok(SimdChoice::W8),
             "1" => Ok(SimdChoice::W1),
@@ -292,6 +293,56 @@ impl std::str::FromStr for SimdChoice {
                 "unknown SIMD width '{s}': expected auto, 16, 8 or 1"
             )),
         }
+    }
+}
+
+impl SimdChoice {
+    fn from_width(w: u64) -> Option<Self> {
+        match w {
+            16 => Some(SimdChoice::W16),
+            8 => Some(SimdChoice::W8),
+            1 => Some(SimdChoice::W1),
+            _ => None,
+        }
+    }
+}
+
+impl<'de> serde::Deserialize<'de> for SimdChoice {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl serde::de::Visitor<'_> for V {
+            type Value = SimdChoice;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a lane width: Auto, 16, 8 or 1")
+            }
+            fn visit_u64<E: serde::de::Error>(self, w: u64) -> Result<SimdChoice, E> {
+                SimdChoice::from_width(w).ok_or_else(|| {
+                    E::custom(format!("lane width {w} is not one of Auto, 16, 8, 1"))
+                })
+            }
+            fn visit_i64<E: serde::de::Error>(self, w: i64) -> Result<SimdChoice, E> {
+                match u64::try_from(w) {
+                    Ok(w) => self.visit_u64(w),
+                    Err(_) => Err(E::custom(format!(
+                        "lane width {w} is not one of Auto, 16, 8, 1"
+                    ))),
+                }
+            }
+            // RON hands a bare identifier over without its name, so `Auto` could not be told
+            // from a typo: the file form is the string.
+            fn visit_unit<E: serde::de::Error>(self) -> Result<SimdChoice, E> {
+                Err(E::custom(
+                    "write the lane width as 16, 8, 1 or \"auto\" (in quotes)",
+                ))
+            }
+            fn visit_str<E: serde::de::Error>(self, s: &str) -> Result<SimdChoice, E> {
+                match s {
+                    "Auto" | "auto" => Ok(SimdChoice::Auto),
+                    _ => Err(E::custom(format!("'{s}' is not one of Auto, 16, 8, 1"))),
+                }
+            }
+        }
+        d.deserialize_any(V)
     }
 }
 
@@ -484,5 +535,23 @@ pub fn dispatch<K: LaneKernel>(lanes: Lanes, k: K) -> K::Output {
         #[cfg(target_arch = "x86_64")]
         // SAFETY: as above.
         Form::Avx512 => unsafe { x86::entry_avx512(k) },
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::SimdChoice;
+
+    #[test]
+    fn simd_choice_reads_widths_and_auto_in_ron() {
+        let read = |s: &str| ron::from_str::<SimdChoice>(s).map_err(|e| e.to_string());
+        assert_eq!(read("16"), Ok(SimdChoice::W16));
+        assert_eq!(read("8"), Ok(SimdChoice::W8));
+        assert_eq!(read("1"), Ok(SimdChoice::W1));
+        assert_eq!(read("\"auto\""), Ok(SimdChoice::Auto));
+        assert!(read("Auto").unwrap_err().contains("in quotes"));
+        assert!(read("Fast").unwrap_err().contains("in quotes"));
+        let e = read("4").unwrap_err();
+        assert!(e.contains("Auto, 16, 8, 1"), "{e}");
     }
 }

@@ -28,6 +28,7 @@ pub fn run(scene: &RenderScene, integrator: Integrator) -> RenderOutput {
         spp: scene.settings.spp,
         time_limit: None,
         integrator,
+        lanes: prism::simd::Lanes::auto(),
     };
     render(scene, &opts, &|_| {})
 }

@@ -1,0 +1,621 @@
+//! The packet kernel: one worker traces `F::WIDTH` paths at once, one per lane, their state in
+//! lane-SoA registers, and refills a lane with the tile's next sample as soon as its path ends.
+//!
+//! ```text
+//! refill → intersect + surface (per lane) → emission → light samples → BSDF → roulette → film
+//!    ↑_____________________________________________________________________________|
+//! ```
+//!
+//! Camera rays, the sampler, the BSDFs, MIS, Russian roulette and the throughput arithmetic
+//! run over lanes, written once over [`Float`] with the scalar integrator's operations in the
+//! same order, so a lane's path is the reference path up to rounding (and bit for bit where
+//! both use the same lane functions). What still runs one lane at a time inside the packet:
+//! the kd-tree walk and primitive tests, surface reconstruction with its texture lookups,
+//! light-sample geometry and the shadow rays' any-hit walk.
+//!
+//! Covers RGB transport without media, with or without MOTION, LENS, TEXTURES and
+//! NORMAL_MAPS; the other variants run the per-path integrator (`super::packet_supports`).
+
+use super::bsdf::{Chan, Dielectric, Diffuse, Frame, Mirror, Mode};
+use super::path::{Ctx, DIM_BOUNCE, DIMS_PER_BOUNCE, camera_rays};
+use super::transport::{Rgb, Transport};
+use super::{RenderStats, Tile};
+use crate::components::Material;
+use crate::geometry::{Ray, offset_ray_origin, offset_ray_origin_lanes, spawn_ray_to};
+use crate::simd::{Float, Mask, UInt, V3};
+use crate::systems::primitives::emitted;
+use glam::{Vec2, Vec3};
+
+type C3<F> = Chan<F, 3>;
+type U<F> = <F as Float>::U32;
+type M<F> = <F as Float>::Mask;
+
+/// The widest packet: scratch arrays for per-lane work are this long.
+const MAX_W: usize = 16;
+
+/// Per-lane material classes after the surface stage.
+const CLASS_NONE: u32 = 0;
+const CLASS_DIFFUSE: u32 = 1;
+const CLASS_MIRROR: u32 = 2;
+const CLASS_DIELECTRIC: u32 = 3;
+
+/// The state of `F::WIDTH` paths, one per lane. Dead lanes hold stale values until refilled.
+#[derive(Clone, Copy)]
+struct Paths<F: Float> {
+    o: V3<F>,
+    d: V3<F>,
+    beta: C3<F>,
+    l: C3<F>,
+    eta_scale: F,
+    depth: U<F>,
+    specular: M<F>,
+    prev_pdf: F,
+    prev_p: V3<F>,
+    time: F,
+    pixel: U<F>,
+    sample: U<F>,
+    alive: M<F>,
+}
+
+/// What the surface stage found at each lane's hit point.
+struct Surface<F: Float> {
+    hit: M<F>,
+    p: V3<F>,
+    /// Geometric and shading normals on the side the ray arrived from.
+    nf: V3<F>,
+    nsf: V3<F>,
+    front: M<F>,
+    class: U<F>,
+    /// Albedo (Diffuse) or tint (Mirror), texture-modulated.
+    color: C3<F>,
+    /// A dielectric's IOR (outside over inside).
+    ior: F,
+    /// Lanes that hit an emitter with non-zero radiance, the radiance and its MIS weight.
+    emits: M<F>,
+    le: C3<F>,
+    le_w: F,
+}
+
+#[inline(always)]
+fn mask_from_bits<F: Float>(bits: u32) -> M<F> {
+    M::<F>::from_fn(|i| bits >> i & 1 != 0)
+}
+
+#[inline(always)]
+fn select_c3<F: Float>(m: M<F>, a: C3<F>, b: C3<F>) -> C3<F> {
+    Chan(std::array::from_fn(|c| F::select(m, a.0[c], b.0[c])))
+}
+
+#[inline(always)]
+fn c3_lane<F: Float>(c: &C3<F>, i: usize) -> Vec3 {
+    Vec3::new(c.0[0].lane(i), c.0[1].lane(i), c.0[2].lane(i))
+}
+
+/// Per-lane results gathered one lane at a time, loaded into lanes afterwards.
+struct Scratch3 {
+    x: [f32; MAX_W],
+    y: [f32; MAX_W],
+    z: [f32; MAX_W],
+}
+
+impl Scratch3 {
+    #[inline(always)]
+    fn new() -> Self {
+        Scratch3 {
+            x: [0.0; MAX_W],
+            y: [0.0; MAX_W],
+            z: [0.0; MAX_W],
+        }
+    }
+    #[inline(always)]
+    fn set(&mut self, i: usize, v: Vec3) {
+        (self.x[i], self.y[i], self.z[i]) = (v.x, v.y, v.z);
+    }
+    #[inline(always)]
+    fn v3<F: Float>(&self) -> V3<F> {
+        V3::new(F::load(&self.x), F::load(&self.y), F::load(&self.z))
+    }
+    #[inline(always)]
+    fn c3<F: Float>(&self) -> C3<F> {
+        Chan([F::load(&self.x), F::load(&self.y), F::load(&self.z)])
+    }
+}
+
+/// glam's `Vec3::dot` over lanes: unfused, in the same order, so the decisions the scalar
+/// integrator takes on glam's dot products come out the same.
+#[inline(always)]
+fn gdot<F: Float>(a: V3<F>, b: V3<F>) -> F {
+    a.x * b.x + a.y * b.y + a.z * b.z
+}
+
+/// glam's `Vec3::normalize` over lanes.
+#[inline(always)]
+fn gnormalize<F: Float>(v: V3<F>) -> V3<F> {
+    v * gdot(v, v).sqrt().recip()
+}
+
+/// `path::reflect_above` over lanes.
+#[inline(always)]
+fn reflect_above<F: Float>(r: V3<F>, n: V3<F>) -> V3<F> {
+    let c = gdot(r, n);
+    let flipped = gnormalize(r - n * (F::splat(2.0) * c));
+    V3::select(c.ge(F::zero()), r, flipped)
+}
+
+/// `path::below` over lanes.
+#[inline(always)]
+fn below<F: Float>(wt: V3<F>, n: V3<F>) -> V3<F> {
+    let c = gdot(wt, n);
+    let flipped = gnormalize(wt - n * (F::splat(2.0) * c));
+    V3::select(c.le(F::zero()), wt, flipped)
+}
+
+#[inline(always)]
+fn power_heuristic<F: Float>(a: F, b: F) -> F {
+    let (a2, b2) = (a * a, b * b);
+    let s = a2 + b2;
+    F::select(s.eq(F::zero()), F::zero(), a2 / s)
+}
+
+/// The scalar MIS weight of an emitter found by chance (`path::shade`'s `mis_emitter`).
+#[inline(always)]
+fn power_heuristic1(a: f32, b: f32) -> f32 {
+    let (a2, b2) = (a * a, b * b);
+    if a2 + b2 == 0.0 { 0.0 } else { a2 / (a2 + b2) }
+}
+
+/// Starts new paths in the dead lanes, from the tile's next samples (pixel-major, as the
+/// per-path integrator orders them).
+#[inline(always)]
+fn refill<F: Float, const MOTION: bool>(
+    ctx: &Ctx,
+    tile: &Tile,
+    s0: u32,
+    spp: usize,
+    total: usize,
+    next: &mut usize,
+    st: &mut Paths<F>,
+) {
+    let mut x = [0u32; MAX_W];
+    let mut y = [0u32; MAX_W];
+    let mut idx = [0u32; MAX_W];
+    let mut fresh = 0u32;
+    let alive = st.alive.bits();
+    for i in 0..F::WIDTH {
+        if alive >> i & 1 == 0 && *next < total {
+            let (p, k) = (*next / spp, *next % spp);
+            (x[i], y[i]) = tile.pixel(p);
+            idx[i] = s0 + k as u32;
+            fresh |= 1 << i;
+            *next += 1;
+        }
+    }
+    if fresh == 0 {
+        return;
+    }
+    let fm = mask_from_bits::<F>(fresh);
+    let (xl, yl, il) = (
+        U::<F>::from_fn(|i| x[i]),
+        U::<F>::from_fn(|i| y[i]),
+        U::<F>::from_fn(|i| idx[i]),
+    );
+    let cam = camera_rays::<F, MOTION>(ctx, xl, yl, il);
+    st.o = V3::select(fm, cam.o, st.o);
+    st.d = V3::select(fm, cam.d, st.d);
+    st.time = F::select(fm, cam.time, st.time);
+    st.beta = select_c3(fm, C3::<F>::splat_all(F::one()), st.beta);
+    st.l = select_c3(fm, C3::<F>::splat_all(F::zero()), st.l);
+    st.eta_scale = F::select(fm, F::one(), st.eta_scale);
+    st.depth = U::<F>::select(fm, U::<F>::splat(0), st.depth);
+    st.specular = st.specular.and_not(fm);
+    st.prev_pdf = F::select(fm, F::zero(), st.prev_pdf);
+    st.prev_p = V3::select(fm, cam.o, st.prev_p);
+    let pixel = yl.wrapping_mul(U::<F>::splat(ctx.width)).wrapping_add(xl);
+    st.pixel = U::<F>::select(fm, pixel, st.pixel);
+    st.sample = U::<F>::select(fm, il, st.sample);
+    st.alive |= fm;
+}
+
+impl<F: Float> C3<F> {
+    #[inline(always)]
+    fn splat_all(v: F) -> Self {
+        Chan([v; 3])
+    }
+    #[inline(always)]
+    fn is_zero(&self) -> M<F> {
+        self.0[0].eq(F::zero()) & self.0[1].eq(F::zero()) & self.0[2].eq(F::zero())
+    }
+}
+
+/// Closest hits and what lies there, one lane at a time: the kd walk, the surface, its
+/// textures and material, and for emitters their radiance with its MIS weight.
+#[inline(always)]
+fn surfaces<F: Float, const MOTION: bool>(ctx: &Ctx, st: &Paths<F>) -> Surface<F> {
+    let scene = ctx.scene;
+    let prims = &scene.prims;
+    let (mut p, mut n, mut ns) = (Scratch3::new(), Scratch3::new(), Scratch3::new());
+    let (mut color, mut le) = (Scratch3::new(), Scratch3::new());
+    let mut class = [CLASS_NONE; MAX_W];
+    let mut ior = [1.0f32; MAX_W];
+    let mut le_w = [0.0f32; MAX_W];
+    let (mut hit_bits, mut front_bits, mut emit_bits) = (0u32, 0u32, 0u32);
+    let alive = st.alive.bits();
+    for i in 0..F::WIDTH {
+        if alive >> i & 1 == 0 {
+            continue;
+        }
+        let ray = Ray::new(st.o.lane(i), st.d.lane(i));
+        let time = st.time.lane(i);
+        let Some(hit) = scene.intersect::<MOTION>(&ray, f32::INFINITY, time) else {
+            continue;
+        };
+        hit_bits |= 1 << i;
+        let mut sp = prims.surface_at::<MOTION>(&ray, &hit, time);
+        let mut material = prims.materials[prims.material[hit.prim as usize] as usize];
+        if (ctx.textures || ctx.normal_maps)
+            && let Some(tex) = prims.texture_of(hit.prim)
+        {
+            let (uv, dpdu, dpdv) = prims.uv_frame::<MOTION>(&ray, &hit, &sp, time);
+            if ctx.textures
+                && let Some(a) = tex.albedo(uv)
+            {
+                material = material.modulated(a);
+            }
+            if ctx.normal_maps && tex.normal_map.is_some() {
+                let nm = tex.shading_normal(uv, sp.ns, dpdu, dpdv);
+                sp.ns = if nm.dot(sp.n) < 0.0 { -nm } else { nm };
+            }
+        }
+        p.set(i, sp.p);
+        n.set(i, sp.facing());
+        ns.set(i, sp.shading_facing());
+        front_bits |= (sp.front as u32) << i;
+        match material {
+            Material::Diffuse { albedo } => {
+                class[i] = CLASS_DIFFUSE;
+                color.set(i, albedo);
+            }
+            Material::Mirror { tint } => {
+                class[i] = CLASS_MIRROR;
+                color.set(i, tint);
+            }
+            Material::Dielectric { ior: model } => {
+                class[i] = CLASS_DIELECTRIC;
+                let mut unused = Vec3::ONE;
+                ior[i] = Rgb::eta(&model, &mut (), &mut unused);
+            }
+            Material::Light { .. } => {
+                let radiance = emitted(&material, sp.n, -ray.d);
+                if radiance != Vec3::ZERO {
+                    emit_bits |= 1 << i;
+                    le.set(i, radiance);
+                    let (depth, specular) = (st.depth.lane(i), st.specular.lane(i));
+                    le_w[i] = if depth == 0 || specular || !ctx.nee {
+                        1.0
+                    } else {
+                        let pdf = scene.lights.pdf_area::<MOTION>(
+                            prims,
+                            hit.prim,
+                            st.prev_p.lane(i),
+                            sp.p,
+                            sp.n,
+                            time,
+                        );
+                        power_heuristic1(st.prev_pdf.lane(i), pdf)
+                    };
+                }
+            }
+            Material::Boundary => {}
+        }
+    }
+    Surface {
+        hit: mask_from_bits::<F>(hit_bits),
+        p: p.v3(),
+        nf: n.v3(),
+        nsf: ns.v3(),
+        front: mask_from_bits::<F>(front_bits),
+        class: U::<F>::from_fn(|i| class[i]),
+        color: color.c3(),
+        ior: F::load(&ior),
+        emits: mask_from_bits::<F>(emit_bits),
+        le: le.c3(),
+        le_w: F::load(&le_w),
+    }
+}
+
+/// Next-event estimation at the diffuse lanes `dm`: a light sample per lane, its BSDF value
+/// and MIS weight over lanes, then a shadow ray per lane whose contribution is not zero.
+#[inline(always)]
+fn light_samples<F: Float, const MOTION: bool>(
+    ctx: &Ctx,
+    st: &mut Paths<F>,
+    sf: &Surface<F>,
+    dm: M<F>,
+    frame: &Frame<F>,
+    dim: U<F>,
+    stats: &mut RenderStats,
+) {
+    let wo_l = frame.to_local(-st.d);
+    let scene = ctx.scene;
+    let prims = &scene.prims;
+    let u_sel = ctx.sampler.get_1d_lanes::<F>(st.pixel, st.sample, dim);
+    let (ux, uy) =
+        ctx.sampler
+            .get_2d_lanes::<F>(st.pixel, st.sample, dim.wrapping_add(U::<F>::splat(1)));
+    let (mut wi, mut rad, mut q, mut nq) = (
+        Scratch3::new(),
+        Scratch3::new(),
+        Scratch3::new(),
+        Scratch3::new(),
+    );
+    let mut pdf = [1.0f32; MAX_W];
+    // Where the shadow ray goes: 0 none, 1 a point light, 2 a point on a surface, 3 a
+    // direction (the environment).
+    let mut kind = [0u8; MAX_W];
+    let mut delta_bits = 0u32;
+    let m = dm.bits();
+    for i in 0..F::WIDTH {
+        if m >> i & 1 == 0 {
+            continue;
+        }
+        let u_l = Vec2::new(ux.lane(i), uy.lane(i));
+        let Some(ls) = scene.lights.sample::<MOTION>(
+            prims,
+            sf.p.lane(i),
+            u_sel.lane(i),
+            u_l,
+            st.time.lane(i),
+            ctx.textures,
+        ) else {
+            continue;
+        };
+        wi.set(i, ls.wi);
+        rad.set(i, ls.radiance);
+        pdf[i] = ls.pdf;
+        delta_bits |= (ls.delta as u32) << i;
+        kind[i] = match ls.point {
+            Some((qp, _)) if ls.delta => {
+                q.set(i, qp);
+                1
+            }
+            Some((qp, qn)) => {
+                q.set(i, qp);
+                nq.set(i, qn);
+                2
+            }
+            None => 3,
+        };
+    }
+    let has = mask_from_bits::<F>(
+        kind.iter()
+            .enumerate()
+            .fold(0u32, |b, (i, &k)| b | ((k != 0) as u32) << i),
+    );
+    let wi = wi.v3::<F>();
+    let wi_l = frame.to_local(wi);
+    let cos = wi_l.z;
+    let ok = has & cos.gt(F::zero()) & gdot(wi, sf.nf).gt(F::zero());
+    if ok.none() {
+        return;
+    }
+    let bsdf = Diffuse { albedo: sf.color };
+    let bsdf_pdf = bsdf.pdf(wo_l, wi_l);
+    let f = bsdf.eval(wo_l, wi_l) * cos;
+    let pdf = F::load(&pdf);
+    let delta = mask_from_bits::<F>(delta_bits);
+    let w = F::select(delta, F::one(), power_heuristic(pdf, bsdf_pdf));
+    let contrib = st.beta * f * rad.c3::<F>() * (w / pdf);
+    let shoot = (ok & !contrib.is_zero()).bits();
+    let mut lit = 0u32;
+    for (i, &k) in kind.iter().enumerate().take(F::WIDTH) {
+        if shoot >> i & 1 == 0 {
+            continue;
+        }
+        let (p, nf) = (sf.p.lane(i), sf.nf.lane(i));
+        let (ray, t_max) = match k {
+            1 => {
+                let o = offset_ray_origin(p, nf);
+                let qp = Vec3::new(q.x[i], q.y[i], q.z[i]);
+                (Ray::new(o, qp - o), 1.0 - 1e-4)
+            }
+            2 => spawn_ray_to(
+                p,
+                nf,
+                Vec3::new(q.x[i], q.y[i], q.z[i]),
+                Vec3::new(nq.x[i], nq.y[i], nq.z[i]),
+            ),
+            _ => (
+                Ray::new(offset_ray_origin(p, nf), wi.lane(i)),
+                f32::INFINITY,
+            ),
+        };
+        stats.shadow_rays += 1;
+        if !scene.occluded::<MOTION>(&ray, t_max, st.time.lane(i)) {
+            lit |= 1 << i;
+        }
+    }
+    let lit = mask_from_bits::<F>(lit);
+    st.l = select_c3(lit, st.l + contrib, st.l);
+}
+
+/// Renders samples `s0..s1` of every pixel of `tile` with packets of `F::WIDTH` paths, adding
+/// each finished path's radiance to `film` (the tile's pixels, row-major).
+#[inline(always)]
+pub fn render_tile<F: Float, const MOTION: bool>(
+    ctx: &Ctx,
+    tile: &Tile,
+    s0: u32,
+    s1: u32,
+    film: &mut [[f64; 3]],
+    stats: &mut RenderStats,
+) {
+    let spp = (s1 - s0) as usize;
+    let total = tile.pixels() * spp;
+    let mut next = 0usize;
+    let zero3 = V3::<F>::zero();
+    let mut st = Paths::<F> {
+        o: zero3,
+        d: zero3,
+        beta: C3::<F>::splat_all(F::zero()),
+        l: C3::<F>::splat_all(F::zero()),
+        eta_scale: F::one(),
+        depth: U::<F>::splat(0),
+        specular: M::<F>::splat(false),
+        prev_pdf: F::zero(),
+        prev_p: zero3,
+        time: F::zero(),
+        pixel: U::<F>::splat(0),
+        sample: U::<F>::splat(0),
+        alive: M::<F>::splat(false),
+    };
+    let scene = ctx.scene;
+    let env = scene.environment;
+    let max_depth = U::<F>::splat(ctx.max_depth);
+    loop {
+        refill::<F, MOTION>(ctx, tile, s0, spp, total, &mut next, &mut st);
+        let started = st.alive;
+        if started.none() {
+            break;
+        }
+        stats.rays += started.count() as u64;
+        stats.lane_slots += F::WIDTH as u64;
+        let sf = surfaces::<F, MOTION>(ctx, &st);
+        // Misses see the environment.
+        let miss = started.and_not(sf.hit);
+        if env != Vec3::ZERO && miss.any() {
+            let first = st.depth.eq(U::<F>::splat(0)) | st.specular | M::<F>::splat(!ctx.nee);
+            let w = F::select(
+                first,
+                F::one(),
+                power_heuristic(st.prev_pdf, F::splat(scene.lights.pdf_environment())),
+            );
+            let e = Chan([F::splat(env.x), F::splat(env.y), F::splat(env.z)]);
+            st.l = select_c3(miss, st.l + st.beta * e * w, st.l);
+        }
+        // Emitters add their radiance and absorb the rest.
+        st.l = select_c3(sf.emits, st.l + st.beta * sf.le * sf.le_w, st.l);
+        let scatters = !sf.class.eq(U::<F>::splat(CLASS_NONE));
+        st.alive = started & sf.hit & scatters & st.depth.lt(max_depth);
+        if st.alive.any() {
+            scatter::<F, MOTION>(ctx, &mut st, &sf, stats);
+        }
+        // Finished paths go to the film.
+        let ended = started.and_not(st.alive).bits();
+        for i in 0..F::WIDTH {
+            if ended >> i & 1 != 0 {
+                super::accumulate(
+                    film,
+                    tile,
+                    ctx.width,
+                    st.pixel.lane(i),
+                    c3_lane(&st.l, i),
+                    stats,
+                );
+            }
+        }
+    }
+}
+
+/// One scattering event in every live lane: light samples at diffuse lanes, then a BSDF
+/// sample per material class present, then Russian roulette.
+#[inline(always)]
+fn scatter<F: Float, const MOTION: bool>(
+    ctx: &Ctx,
+    st: &mut Paths<F>,
+    sf: &Surface<F>,
+    stats: &mut RenderStats,
+) {
+    let live = st.alive;
+    let dim = U::<F>::splat(DIM_BOUNCE)
+        .wrapping_add(st.depth.wrapping_mul(U::<F>::splat(DIMS_PER_BOUNCE)));
+    st.depth = U::<F>::select(live, st.depth.wrapping_add(U::<F>::splat(1)), st.depth);
+    let wo = -st.d;
+    let frame = Frame::from_normal(sf.nsf);
+    let wo_l = frame.to_local(wo);
+    let class = |c: u32| live & sf.class.eq(U::<F>::splat(c));
+    let (dm, mm, em) = (
+        class(CLASS_DIFFUSE),
+        class(CLASS_MIRROR),
+        class(CLASS_DIELECTRIC),
+    );
+    let up = offset_ray_origin_lanes(sf.p, sf.nf);
+    let mut scattered = M::<F>::splat(false);
+    if dm.any() {
+        if ctx.nee {
+            light_samples::<F, MOTION>(ctx, st, sf, dm, &frame, dim, stats);
+        }
+        let (ux, uy) =
+            ctx.sampler
+                .get_2d_lanes::<F>(st.pixel, st.sample, dim.wrapping_add(U::<F>::splat(4)));
+        let bs = Diffuse { albedo: sf.color }.sample(wo_l, ux, uy);
+        let wi = frame.to_world(bs.wi).normalize();
+        // Sampled around a tilted shading normal into the geometric back side: absorbed.
+        let ok = dm & gdot(wi, sf.nf).gt(F::zero());
+        st.alive = st.alive.and_not(dm.and_not(ok));
+        st.beta = select_c3(ok, st.beta * bs.weight, st.beta);
+        st.prev_pdf = F::select(ok, bs.pdf, st.prev_pdf);
+        st.specular = st.specular.and_not(ok);
+        st.o = V3::select(ok, up, st.o);
+        st.d = V3::select(ok, wi, st.d);
+        scattered |= ok;
+    }
+    if mm.any() {
+        let bs = Mirror { tint: sf.color }.sample(wo_l);
+        st.beta = select_c3(mm, st.beta * bs.weight, st.beta);
+        st.specular |= mm;
+        let wi = frame.to_world(bs.wi);
+        st.o = V3::select(mm, up, st.o);
+        st.d = V3::select(mm, reflect_above(wi, sf.nf), st.d);
+        scattered |= mm;
+    }
+    if em.any() {
+        let eta = F::select(sf.front, sf.ior, sf.ior.recip());
+        let u =
+            ctx.sampler
+                .get_1d_lanes::<F>(st.pixel, st.sample, dim.wrapping_add(U::<F>::splat(3)));
+        let bsdf = Dielectric {
+            eta,
+            schlick: ctx.schlick,
+        };
+        let bs = bsdf.sample::<C3<F>>(wo_l, u, Mode::Radiance);
+        st.specular |= em;
+        st.beta = select_c3(em, st.beta * bs.weight, st.beta);
+        let wi = frame.to_world(bs.wi);
+        let t = em & bs.is_transmission();
+        st.eta_scale = F::select(t, st.eta_scale * (bs.eta * bs.eta), st.eta_scale);
+        let down = offset_ray_origin_lanes(sf.p, -sf.nf);
+        let o = V3::select(t, down, up);
+        let d = V3::select(t, below(wi, sf.nf), reflect_above(wi, sf.nf));
+        st.o = V3::select(em, o, st.o);
+        st.d = V3::select(em, d, st.d);
+        scattered |= em;
+    }
+    st.prev_p = V3::select(scattered, sf.p, st.prev_p);
+    russian_roulette(ctx, st, scattered, dim.wrapping_add(U::<F>::splat(6)));
+}
+
+/// `path::russian_roulette` over lanes, for the lanes in `m`.
+#[inline(always)]
+fn russian_roulette<F: Float>(ctx: &Ctx, st: &mut Paths<F>, m: M<F>, dim: U<F>) {
+    let deep = m & !st.depth.lt(U::<F>::splat(ctx.rr_depth));
+    if deep.any() {
+        let b = st.beta.0.map(|c| c * st.eta_scale);
+        let rr = b[0].max(b[1]).max(b[2]);
+        let low = deep & rr.lt(F::one());
+        if low.any() {
+            let q = (F::one() - rr).max(F::zero());
+            let u = ctx.sampler.get_1d_lanes::<F>(st.pixel, st.sample, dim);
+            let kill = low & u.lt(q);
+            st.alive = st.alive.and_not(kill);
+            let keep = low.and_not(kill);
+            let k = F::one() - q;
+            st.beta = select_c3(keep, Chan(st.beta.0.map(|c| c / k)), st.beta);
+        }
+    }
+    st.alive = st.alive.and_not(m & st.beta.is_zero());
+}
+
+/// Which effect variants the packet kernel runs: RGB transport without media.
+pub fn supports(spectral: bool, media: bool) -> bool {
+    !spectral && !media
+}
