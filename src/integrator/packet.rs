@@ -16,12 +16,14 @@
 //! Covers RGB transport without media, with or without MOTION, LENS, TEXTURES and
 //! NORMAL_MAPS; the other variants run the per-path integrator (`super::packet_supports`).
 
-use super::bsdf::{Chan, Dielectric, Diffuse, Frame, Mirror, Mode};
-use super::path::{Ctx, DIM_BOUNCE, DIMS_PER_BOUNCE, camera_rays};
+use super::bsdf::{Chan, Dielectric, Diffuse, Frame, LaneChannels, Mirror, Mode};
+use super::path::{
+    self, Ctx, DIM_BOUNCE, DIMS_PER_BOUNCE, camera_rays, shadow_ray_from_surface, surface_material,
+};
 use super::transport::{Rgb, Transport};
 use super::{RenderStats, Tile};
 use crate::components::Material;
-use crate::geometry::{Ray, offset_ray_origin, offset_ray_origin_lanes, spawn_ray_to};
+use crate::geometry::{Ray, offset_ray_origin_lanes};
 use crate::simd::{Float, Mask, UInt, V3};
 use crate::systems::primitives::emitted;
 use glam::{Vec2, Vec3};
@@ -157,13 +159,6 @@ fn power_heuristic<F: Float>(a: F, b: F) -> F {
     F::select(s.eq(F::zero()), F::zero(), a2 / s)
 }
 
-/// The scalar MIS weight of an emitter found by chance (`path::shade`'s `mis_emitter`).
-#[inline(always)]
-fn power_heuristic1(a: f32, b: f32) -> f32 {
-    let (a2, b2) = (a * a, b * b);
-    if a2 + b2 == 0.0 { 0.0 } else { a2 / (a2 + b2) }
-}
-
 /// Starts new paths in the dead lanes, from the tile's next samples (pixel-major, as the
 /// per-path integrator orders them).
 #[inline(always)]
@@ -203,8 +198,8 @@ fn refill<F: Float, const MOTION: bool>(
     st.o = V3::select(fm, cam.o, st.o);
     st.d = V3::select(fm, cam.d, st.d);
     st.time = F::select(fm, cam.time, st.time);
-    st.beta = select_c3(fm, C3::<F>::splat_all(F::one()), st.beta);
-    st.l = select_c3(fm, C3::<F>::splat_all(F::zero()), st.l);
+    st.beta = select_c3(fm, C3::<F>::splat(F::one()), st.beta);
+    st.l = select_c3(fm, C3::<F>::splat(F::zero()), st.l);
     st.eta_scale = F::select(fm, F::one(), st.eta_scale);
     st.depth = U::<F>::select(fm, U::<F>::splat(0), st.depth);
     st.specular = st.specular.and_not(fm);
@@ -217,10 +212,6 @@ fn refill<F: Float, const MOTION: bool>(
 }
 
 impl<F: Float> C3<F> {
-    #[inline(always)]
-    fn splat_all(v: F) -> Self {
-        Chan([v; 3])
-    }
     #[inline(always)]
     fn is_zero(&self) -> M<F> {
         self.0[0].eq(F::zero()) & self.0[1].eq(F::zero()) & self.0[2].eq(F::zero())
@@ -250,22 +241,7 @@ fn surfaces<F: Float, const MOTION: bool>(ctx: &Ctx, st: &Paths<F>) -> Surface<F
             continue;
         };
         hit_bits |= 1 << i;
-        let mut sp = prims.surface_at::<MOTION>(&ray, &hit, time);
-        let mut material = prims.materials[prims.material[hit.prim as usize] as usize];
-        if (ctx.textures || ctx.normal_maps)
-            && let Some(tex) = prims.texture_of(hit.prim)
-        {
-            let (uv, dpdu, dpdv) = prims.uv_frame::<MOTION>(&ray, &hit, &sp, time);
-            if ctx.textures
-                && let Some(a) = tex.albedo(uv)
-            {
-                material = material.modulated(a);
-            }
-            if ctx.normal_maps && tex.normal_map.is_some() {
-                let nm = tex.shading_normal(uv, sp.ns, dpdu, dpdv);
-                sp.ns = if nm.dot(sp.n) < 0.0 { -nm } else { nm };
-            }
-        }
+        let (sp, material, _) = surface_material::<MOTION>(ctx, &ray, &hit, time);
         p.set(i, sp.p);
         n.set(i, sp.facing());
         ns.set(i, sp.shading_facing());
@@ -301,7 +277,7 @@ fn surfaces<F: Float, const MOTION: bool>(ctx: &Ctx, st: &Paths<F>) -> Surface<F
                             sp.n,
                             time,
                         );
-                        power_heuristic1(st.prev_pdf.lane(i), pdf)
+                        path::power_heuristic(st.prev_pdf.lane(i), pdf)
                     };
                 }
             }
@@ -342,16 +318,11 @@ fn light_samples<F: Float, const MOTION: bool>(
     let (ux, uy) =
         ctx.sampler
             .get_2d_lanes::<F>(st.pixel, st.sample, dim.wrapping_add(U::<F>::splat(1)));
-    let (mut wi, mut rad, mut q, mut nq) = (
-        Scratch3::new(),
-        Scratch3::new(),
-        Scratch3::new(),
-        Scratch3::new(),
-    );
+    let (mut wi, mut rad) = (Scratch3::new(), Scratch3::new());
     let mut pdf = [1.0f32; MAX_W];
-    // Where the shadow ray goes: 0 none, 1 a point light, 2 a point on a surface, 3 a
-    // direction (the environment).
-    let mut kind = [0u8; MAX_W];
+    // Where each lane's shadow ray goes (see `shadow_ray_from_surface`).
+    let mut point = [None; MAX_W];
+    let mut has_bits = 0u32;
     let mut delta_bits = 0u32;
     let m = dm.bits();
     for i in 0..F::WIDTH {
@@ -373,24 +344,10 @@ fn light_samples<F: Float, const MOTION: bool>(
         rad.set(i, ls.radiance);
         pdf[i] = ls.pdf;
         delta_bits |= (ls.delta as u32) << i;
-        kind[i] = match ls.point {
-            Some((qp, _)) if ls.delta => {
-                q.set(i, qp);
-                1
-            }
-            Some((qp, qn)) => {
-                q.set(i, qp);
-                nq.set(i, qn);
-                2
-            }
-            None => 3,
-        };
+        point[i] = ls.point;
+        has_bits |= 1 << i;
     }
-    let has = mask_from_bits::<F>(
-        kind.iter()
-            .enumerate()
-            .fold(0u32, |b, (i, &k)| b | ((k != 0) as u32) << i),
-    );
+    let has = mask_from_bits::<F>(has_bits);
     let wi = wi.v3::<F>();
     let wi_l = frame.to_local(wi);
     let cos = wi_l.z;
@@ -407,28 +364,12 @@ fn light_samples<F: Float, const MOTION: bool>(
     let contrib = st.beta * f * rad.c3::<F>() * (w / pdf);
     let shoot = (ok & !contrib.is_zero()).bits();
     let mut lit = 0u32;
-    for (i, &k) in kind.iter().enumerate().take(F::WIDTH) {
+    for (i, &pt) in point.iter().enumerate().take(F::WIDTH) {
         if shoot >> i & 1 == 0 {
             continue;
         }
         let (p, nf) = (sf.p.lane(i), sf.nf.lane(i));
-        let (ray, t_max) = match k {
-            1 => {
-                let o = offset_ray_origin(p, nf);
-                let qp = Vec3::new(q.x[i], q.y[i], q.z[i]);
-                (Ray::new(o, qp - o), 1.0 - 1e-4)
-            }
-            2 => spawn_ray_to(
-                p,
-                nf,
-                Vec3::new(q.x[i], q.y[i], q.z[i]),
-                Vec3::new(nq.x[i], nq.y[i], nq.z[i]),
-            ),
-            _ => (
-                Ray::new(offset_ray_origin(p, nf), wi.lane(i)),
-                f32::INFINITY,
-            ),
-        };
+        let (ray, t_max) = shadow_ray_from_surface(p, nf, pt, delta_bits >> i & 1 != 0, wi.lane(i));
         stats.shadow_rays += 1;
         if !scene.occluded::<MOTION>(&ray, t_max, st.time.lane(i)) {
             lit |= 1 << i;
@@ -456,8 +397,8 @@ pub fn render_tile<F: Float, const MOTION: bool>(
     let mut st = Paths::<F> {
         o: zero3,
         d: zero3,
-        beta: C3::<F>::splat_all(F::zero()),
-        l: C3::<F>::splat_all(F::zero()),
+        beta: C3::<F>::splat(F::zero()),
+        l: C3::<F>::splat(F::zero()),
         eta_scale: F::one(),
         depth: U::<F>::splat(0),
         specular: M::<F>::splat(false),

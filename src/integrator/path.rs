@@ -133,7 +133,7 @@ pub struct ShadowRequest<S> {
 }
 
 #[inline]
-fn power_heuristic(a: f32, b: f32) -> f32 {
+pub(crate) fn power_heuristic(a: f32, b: f32) -> f32 {
     let (a2, b2) = (a * a, b * b);
     if a2 + b2 == 0.0 { 0.0 } else { a2 / (a2 + b2) }
 }
@@ -316,6 +316,60 @@ pub fn lens_point_lanes<F: Float>(ux: F, uy: F, blades: u32) -> (F, F) {
     (c0 * b0 + c1 * b1, s0 * b0 + s1 * b1)
 }
 
+/// The surface at `hit` with its material after textures: the albedo texture modulates the
+/// material (and is returned for spectral upsampling), a normal map tilts the shading normal.
+#[inline(always)]
+pub(crate) fn surface_material<const MOTION: bool>(
+    ctx: &Ctx,
+    ray: &Ray,
+    hit: &Hit,
+    time: f32,
+) -> (crate::geometry::SurfacePoint, Material, Option<Vec3>) {
+    let prims = &ctx.scene.prims;
+    let mut sp = prims.surface_at::<MOTION>(ray, hit, time);
+    let mut material = prims.materials[prims.material[hit.prim as usize] as usize];
+    let mut tex_albedo = None;
+    if (ctx.textures || ctx.normal_maps)
+        && let Some(tex) = prims.texture_of(hit.prim)
+    {
+        let (uv, dpdu, dpdv) = prims.uv_frame::<MOTION>(ray, hit, &sp, time);
+        if ctx.textures
+            && let Some(a) = tex.albedo(uv)
+        {
+            material = material.modulated(a);
+            tex_albedo = Some(a);
+        }
+        if ctx.normal_maps && tex.normal_map.is_some() {
+            // As pbrt does: the perturbed normal is turned to the geometric normal's side;
+            // directions it would send below the geometric surface are absorbed in scattering.
+            let ns = tex.shading_normal(uv, sp.ns, dpdu, dpdv);
+            sp.ns = if ns.dot(sp.n) < 0.0 { -ns } else { ns };
+        }
+    }
+    (sp, material, tex_albedo)
+}
+
+/// The shadow ray of a light sample taken at surface point `p` (normal `nf` on the side the
+/// path is on): to a point light, stopping just short of it (it sits on no surface); to a
+/// point on an emitter, offset at both ends; or along `wi` to the environment.
+#[inline(always)]
+pub(crate) fn shadow_ray_from_surface(
+    p: Vec3,
+    nf: Vec3,
+    point: Option<(Vec3, Vec3)>,
+    delta: bool,
+    wi: Vec3,
+) -> (Ray, f32) {
+    match point {
+        Some((q, _)) if delta => {
+            let o = offset_ray_origin(p, nf);
+            (Ray::new(o, q - o), 1.0 - 1e-4)
+        }
+        Some((q, nq)) => spawn_ray_to(p, nf, q, nq),
+        None => (Ray::new(offset_ray_origin(p, nf), wi), f32::INFINITY),
+    }
+}
+
 /// A reflected direction kept on the side of `n`: at grazing angles (or about a tilted shading
 /// normal) it can point a hair below the surface, and it must leave on the side it is spawned.
 #[inline]
@@ -399,27 +453,8 @@ pub fn shade<T: Transport, const MOTION: bool, const MEDIA: bool>(
         return None;
     };
     let prims = &scene.prims;
-    let mut sp = prims.surface_at::<MOTION>(&s.ray, &hit, s.time);
     let mat = prims.material[hit.prim as usize];
-    let mut material = prims.materials[mat as usize];
-    let mut tex_albedo = None;
-    if (ctx.textures || ctx.normal_maps)
-        && let Some(tex) = prims.texture_of(hit.prim)
-    {
-        let (uv, dpdu, dpdv) = prims.uv_frame::<MOTION>(&s.ray, &hit, &sp, s.time);
-        if ctx.textures
-            && let Some(a) = tex.albedo(uv)
-        {
-            material = material.modulated(a);
-            tex_albedo = Some(a);
-        }
-        if ctx.normal_maps && tex.normal_map.is_some() {
-            // As pbrt does: the perturbed normal is turned to the geometric normal's side;
-            // directions it would send below the geometric surface are absorbed in scattering.
-            let ns = tex.shading_normal(uv, sp.ns, dpdu, dpdv);
-            sp.ns = if ns.dot(sp.n) < 0.0 { -ns } else { ns };
-        }
-    }
+    let (sp, material, tex_albedo) = surface_material::<MOTION>(ctx, &s.ray, &hit, s.time);
     if MEDIA && let Material::Boundary = material {
         // A medium's boundary: carry on in the same direction, in the medium beyond.
         s.medium = prims.medium_after_crossing(hit.prim, sp.front, s.medium);
@@ -484,20 +519,8 @@ pub fn shade<T: Transport, const MOTION: bool, const MEDIA: bool>(
                         let contrib =
                             s.beta * f * T::light_radiance(ctx, &ls, &s.lambda) * (w / ls.pdf);
                         if contrib != T::S::ZERO {
-                            let (ray, t_max) = match ls.point {
-                                // A point light sits on no surface: stop just short of it.
-                                Some((q, _)) if ls.delta => (
-                                    Ray::new(
-                                        offset_ray_origin(sp.p, nf),
-                                        q - offset_ray_origin(sp.p, nf),
-                                    ),
-                                    1.0 - 1e-4,
-                                ),
-                                Some((q, nq)) => spawn_ray_to(sp.p, nf, q, nq),
-                                None => {
-                                    (Ray::new(offset_ray_origin(sp.p, nf), ls.wi), f32::INFINITY)
-                                }
-                            };
+                            let (ray, t_max) =
+                                shadow_ray_from_surface(sp.p, nf, ls.point, ls.delta, ls.wi);
                             shadow = Some(ShadowRequest {
                                 ray,
                                 t_max,
