@@ -230,14 +230,15 @@ fn surfaces<F: Float, const MOTION: bool>(ctx: &Ctx, st: &Paths<F>) -> Surface<F
     let mut ior = [1.0f32; MAX_W];
     let mut le_w = [0.0f32; MAX_W];
     let (mut hit_bits, mut front_bits, mut emit_bits) = (0u32, 0u32, 0u32);
-    let alive = st.alive.bits();
+    let hits = scene.intersect_packet::<F, MOTION>(st.o, st.d, st.alive, st.time);
+    let found = hits.hit.bits();
     for i in 0..F::WIDTH {
-        if alive >> i & 1 == 0 {
+        if found >> i & 1 == 0 {
             continue;
         }
         let ray = Ray::new(st.o.lane(i), st.d.lane(i));
         let time = st.time.lane(i);
-        let Some(hit) = scene.intersect::<MOTION>(&ray, f32::INFINITY, time) else {
+        let Some(hit) = hits.lane(i) else {
             continue;
         };
         hit_bits |= 1 << i;
@@ -362,20 +363,24 @@ fn light_samples<F: Float, const MOTION: bool>(
     let delta = mask_from_bits::<F>(delta_bits);
     let w = F::select(delta, F::one(), power_heuristic(pdf, bsdf_pdf));
     let contrib = st.beta * f * rad.c3::<F>() * (w / pdf);
-    let shoot = (ok & !contrib.is_zero()).bits();
-    let mut lit = 0u32;
+    let shoot = ok & !contrib.is_zero();
+    let bits = shoot.bits();
+    let (mut so, mut sd) = (Scratch3::new(), Scratch3::new());
+    let mut t_max = [0.0f32; MAX_W];
     for (i, &pt) in point.iter().enumerate().take(F::WIDTH) {
-        if shoot >> i & 1 == 0 {
+        if bits >> i & 1 == 0 {
             continue;
         }
         let (p, nf) = (sf.p.lane(i), sf.nf.lane(i));
-        let (ray, t_max) = shadow_ray_from_surface(p, nf, pt, delta_bits >> i & 1 != 0, wi.lane(i));
-        stats.shadow_rays += 1;
-        if !scene.occluded::<MOTION>(&ray, t_max, st.time.lane(i)) {
-            lit |= 1 << i;
-        }
+        let (ray, t) = shadow_ray_from_surface(p, nf, pt, delta_bits >> i & 1 != 0, wi.lane(i));
+        so.set(i, ray.o);
+        sd.set(i, ray.d);
+        t_max[i] = t;
     }
-    let lit = mask_from_bits::<F>(lit);
+    stats.shadow_rays += u64::from(shoot.count());
+    let blocked =
+        scene.occluded_packet::<F, MOTION>(so.v3(), sd.v3(), shoot, F::load(&t_max), st.time);
+    let lit = shoot.and_not(blocked);
     st.l = select_c3(lit, st.l + contrib, st.l);
 }
 

@@ -34,6 +34,7 @@
 
 mod build;
 mod node;
+mod packet;
 mod traverse;
 
 use crate::geometry::Aabb;

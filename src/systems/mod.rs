@@ -3,6 +3,7 @@
 
 pub mod effects;
 pub mod lights;
+pub mod packet;
 pub mod primitives;
 
 pub use effects::{Effect, Effects, detect_effects};

@@ -23,12 +23,22 @@ pub fn scene_file(path: &Path, overrides: &[(&str, &str)]) -> RenderScene {
 }
 
 pub fn run(scene: &RenderScene, integrator: Integrator) -> RenderOutput {
+    run_at(scene, integrator, prism::simd::Lanes::auto())
+}
+
+/// [`run`] at a given lane width.
+#[allow(dead_code)]
+pub fn run_at(
+    scene: &RenderScene,
+    integrator: Integrator,
+    lanes: prism::simd::Lanes,
+) -> RenderOutput {
     let opts = RenderOptions {
         sample_offset: 0,
         spp: scene.settings.spp,
         time_limit: None,
         integrator,
-        lanes: prism::simd::Lanes::auto(),
+        lanes,
     };
     render(scene, &opts, &|_| {})
 }
