@@ -80,6 +80,17 @@ fn solid_angle_pdf(pdf_area: f32, ref_p: Vec3, p: Vec3, n: Vec3) -> f32 {
     }
 }
 
+/// [`solid_angle_pdf`] over lanes, in glam's operation order.
+#[inline(always)]
+fn solid_angle_pdf_lanes<F: Float>(pdf_area: F, ref_p: V3<F>, p: V3<F>, n: V3<F>) -> F {
+    let d = p - ref_p;
+    let dist2 = dot(d, d);
+    let cos = dot(n, d).abs() / dist2.sqrt();
+    let zero = F::zero();
+    let degenerate = cos.le(zero) | dist2.le(zero);
+    F::select(degenerate, zero, pdf_area * dist2 / cos)
+}
+
 /// A sphere in world space. Spheres take similarity transforms only, so centre and radius
 /// describe them fully.
 #[derive(Clone, Copy, Debug)]
@@ -347,6 +358,18 @@ impl Planar {
 
     pub fn pdf(&self, ref_p: Vec3, p: Vec3) -> f32 {
         solid_angle_pdf(1.0 / self.area, ref_p, p, self.n)
+    }
+
+    /// [`Planar::sample`] of a rectangle from one reference point per lane, with the same
+    /// bits: the point and its solid-angle density, 0 where the scalar sample is `None`.
+    #[inline(always)]
+    pub fn sample_rect_lanes<F: Float>(&self, ref_p: V3<F>, ux: F, uy: F) -> (V3<F>, F) {
+        let (one, two) = (F::one(), F::splat(2.0));
+        let (a, b) = (two * ux - one, two * uy - one);
+        let p = V3::splat(self.center) + V3::splat(self.u) * a + V3::splat(self.v) * b;
+        let pdf = solid_angle_pdf_lanes(F::splat(1.0 / self.area), ref_p, p, V3::splat(self.n));
+        let ok = pdf.gt(F::zero()) & pdf.is_finite();
+        (p, F::select(ok, pdf, F::zero()))
     }
 }
 

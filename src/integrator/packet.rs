@@ -17,16 +17,15 @@
 //! NORMAL_MAPS; the other variants run the per-path integrator (`super::packet_supports`).
 
 use super::bsdf::{Chan, Dielectric, Diffuse, Frame, LaneChannels, Mirror, Mode};
-use super::path::{
-    self, Ctx, DIM_BOUNCE, DIMS_PER_BOUNCE, camera_rays, shadow_ray_from_surface, surface_material,
-};
+use super::path::{self, Ctx, DIM_BOUNCE, DIMS_PER_BOUNCE, camera_rays, surface_material};
 use super::transport::{Rgb, Transport};
 use super::{RenderStats, Tile};
 use crate::components::Material;
 use crate::geometry::{Ray, offset_ray_origin_lanes};
 use crate::simd::{Float, Mask, UInt, V3};
+use crate::systems::light_lanes::LaneLightSample;
 use crate::systems::primitives::emitted;
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 
 type C3<F> = Chan<F, 3>;
 type U<F> = <F as Float>::U32;
@@ -319,69 +318,63 @@ fn light_samples<F: Float, const MOTION: bool>(
     let (ux, uy) =
         ctx.sampler
             .get_2d_lanes::<F>(st.pixel, st.sample, dim.wrapping_add(U::<F>::splat(1)));
-    let (mut wi, mut rad) = (Scratch3::new(), Scratch3::new());
-    let mut pdf = [1.0f32; MAX_W];
-    // Where each lane's shadow ray goes (see `shadow_ray_from_surface`).
-    let mut point = [None; MAX_W];
-    let mut has_bits = 0u32;
-    let mut delta_bits = 0u32;
-    let m = dm.bits();
-    for i in 0..F::WIDTH {
-        if m >> i & 1 == 0 {
-            continue;
-        }
-        let u_l = Vec2::new(ux.lane(i), uy.lane(i));
-        let Some(ls) = scene.lights.sample::<MOTION>(
-            prims,
-            sf.p.lane(i),
-            u_sel.lane(i),
-            u_l,
-            st.time.lane(i),
-            ctx.textures,
-        ) else {
-            continue;
-        };
-        wi.set(i, ls.wi);
-        rad.set(i, ls.radiance);
-        pdf[i] = ls.pdf;
-        delta_bits |= (ls.delta as u32) << i;
-        point[i] = ls.point;
-        has_bits |= 1 << i;
-    }
-    let has = mask_from_bits::<F>(has_bits);
-    let wi = wi.v3::<F>();
+    let ls = scene.lights.sample_lanes::<F, MOTION>(
+        prims,
+        sf.p,
+        dm,
+        u_sel,
+        ux,
+        uy,
+        st.time,
+        ctx.textures,
+    );
+    let wi = ls.wi;
     let wi_l = frame.to_local(wi);
     let cos = wi_l.z;
-    let ok = has & cos.gt(F::zero()) & gdot(wi, sf.nf).gt(F::zero());
+    let ok = ls.has & cos.gt(F::zero()) & gdot(wi, sf.nf).gt(F::zero());
     if ok.none() {
         return;
     }
     let bsdf = Diffuse { albedo: sf.color };
     let bsdf_pdf = bsdf.pdf(wo_l, wi_l);
     let f = bsdf.eval(wo_l, wi_l) * cos;
-    let pdf = F::load(&pdf);
-    let delta = mask_from_bits::<F>(delta_bits);
-    let w = F::select(delta, F::one(), power_heuristic(pdf, bsdf_pdf));
-    let contrib = st.beta * f * rad.c3::<F>() * (w / pdf);
+    let pdf = ls.pdf;
+    let w = F::select(ls.delta, F::one(), power_heuristic(pdf, bsdf_pdf));
+    let rad = Chan([ls.radiance.x, ls.radiance.y, ls.radiance.z]);
+    let contrib = st.beta * f * rad * (w / pdf);
     let shoot = ok & !contrib.is_zero();
-    let bits = shoot.bits();
-    let (mut so, mut sd) = (Scratch3::new(), Scratch3::new());
-    let mut t_max = [0.0f32; MAX_W];
-    for (i, &pt) in point.iter().enumerate().take(F::WIDTH) {
-        if bits >> i & 1 == 0 {
-            continue;
-        }
-        let (p, nf) = (sf.p.lane(i), sf.nf.lane(i));
-        let (ray, t) = shadow_ray_from_surface(p, nf, pt, delta_bits >> i & 1 != 0, wi.lane(i));
-        so.set(i, ray.o);
-        sd.set(i, ray.d);
-        t_max[i] = t;
-    }
+    let (so, sd, t_max) = shadow_rays(sf.p, sf.nf, &ls);
     stats.shadow_rays += u64::from(shoot.count());
-    let blocked =
-        scene.occluded_packet::<F, MOTION>(so.v3(), sd.v3(), shoot, F::load(&t_max), st.time);
+    let blocked = scene.occluded_packet::<F, MOTION>(so, sd, shoot, t_max, st.time);
     let lit = shoot.and_not(blocked);
     st.l = select_c3(lit, st.l + contrib, st.l);
+}
+
+/// `path::shadow_ray_from_surface` over lanes: towards the sampled point of an area light
+/// (offset at both ends), a point light's position, or along `wi` to infinity.
+#[inline(always)]
+fn shadow_rays<F: Float>(p: V3<F>, nf: V3<F>, ls: &LaneLightSample<F>) -> (V3<F>, V3<F>, F) {
+    // Area lights: `spawn_ray_to`.
+    let d = ls.q - p;
+    let n = V3::select(gdot(nf, d).ge(F::zero()), nf, -nf);
+    let o_area = offset_ray_origin_lanes(p, n);
+    let nt = V3::select(gdot(ls.nq, d).le(F::zero()), ls.nq, -ls.nq);
+    let end = offset_ray_origin_lanes(ls.q, nt);
+    // Point lights and the environment leave from the surface's own side.
+    let o_up = offset_ray_origin_lanes(p, nf);
+    let area = ls.at_point.and_not(ls.delta);
+    let o = V3::select(area, o_area, o_up);
+    let dir = V3::select(
+        area,
+        end - o_area,
+        V3::select(ls.at_point, ls.q - o_up, ls.wi),
+    );
+    let t_max = F::select(
+        area,
+        F::one(),
+        F::select(ls.at_point, F::splat(1.0 - 1e-4), F::splat(f32::INFINITY)),
+    );
+    (o, dir, t_max)
 }
 
 /// Renders samples `s0..s1` of every pixel of `tile` with packets of `F::WIDTH` paths, adding

@@ -53,7 +53,7 @@ pub enum LightSource {
 
 pub struct Lights {
     pub lights: Vec<LightKind>,
-    table: AliasTable,
+    pub(super) table: AliasTable,
     /// Index of the environment light, if the environment emits.
     pub environment: Option<u32>,
 }

@@ -2,6 +2,7 @@
 //! integrator reads. The acceleration structure and light list live beside the world.
 
 pub mod effects;
+pub mod light_lanes;
 pub mod lights;
 pub mod packet;
 pub mod primitives;

@@ -1,0 +1,205 @@
+//! Light samples from a packet of reference points, one per lane.
+//!
+//! The light is chosen per lane by the alias table; lanes that chose the same light are then
+//! sampled together. Rectangular emitters (the common case: every shipped scene but two lights
+//! its room with one) are sampled in lanes, with the scalar sample's bits. Other lights, and
+//! rectangles that move or carry a texture, take [`Lights::sample`] one lane at a time.
+
+use super::lights::{LightKind, Lights};
+use super::primitives::{NO_MOTION, PrimKind, Primitives};
+use crate::components::Material;
+use crate::simd::{Float, Mask, V3};
+
+type M<F> = <F as Float>::Mask;
+
+/// The widest packet.
+const MAX_W: usize = 16;
+
+/// [`super::LightSample`] of each lane; lanes outside `has` hold no sample.
+#[derive(Clone, Copy)]
+pub struct LaneLightSample<F: Float> {
+    pub has: M<F>,
+    pub wi: V3<F>,
+    pub radiance: V3<F>,
+    pub pdf: F,
+    pub delta: M<F>,
+    /// Lanes whose sample is a point (area, point and spot lights): the point and its normal
+    /// (zero for point and spot lights).
+    pub at_point: M<F>,
+    pub q: V3<F>,
+    pub nq: V3<F>,
+}
+
+impl<F: Float> LaneLightSample<F> {
+    #[inline(always)]
+    fn none() -> Self {
+        let no = M::<F>::splat(false);
+        LaneLightSample {
+            has: no,
+            wi: V3::zero(),
+            radiance: V3::zero(),
+            pdf: F::one(),
+            delta: no,
+            at_point: no,
+            q: V3::zero(),
+            nq: V3::zero(),
+        }
+    }
+
+    /// Takes the lanes of `m` from `o`.
+    #[inline(always)]
+    fn blend(&mut self, m: M<F>, o: &Self) {
+        self.has = (self.has.and_not(m)) | (o.has & m);
+        self.wi = V3::select(m, o.wi, self.wi);
+        self.radiance = V3::select(m, o.radiance, self.radiance);
+        self.pdf = F::select(m, o.pdf, self.pdf);
+        self.delta = (self.delta.and_not(m)) | (o.delta & m);
+        self.at_point = (self.at_point.and_not(m)) | (o.at_point & m);
+        self.q = V3::select(m, o.q, self.q);
+        self.nq = V3::select(m, o.nq, self.nq);
+    }
+}
+
+#[inline(always)]
+fn nonzero<F: Float>(v: V3<F>) -> M<F> {
+    !(v.x.eq(F::zero()) & v.y.eq(F::zero()) & v.z.eq(F::zero()))
+}
+
+impl Lights {
+    /// [`Lights::sample`] for the reference points of lanes `m`, with the same bits.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    pub fn sample_lanes<F: Float, const MOTION: bool>(
+        &self,
+        prims: &Primitives,
+        p: V3<F>,
+        m: M<F>,
+        u_select: F,
+        ux: F,
+        uy: F,
+        time: F,
+        textures: bool,
+    ) -> LaneLightSample<F> {
+        let mut out = LaneLightSample::none();
+        if self.lights.is_empty() || m.none() {
+            return out;
+        }
+        let mut which = [0u32; MAX_W];
+        let mut pmf = [0.0f32; MAX_W];
+        let bits = m.bits();
+        for i in 0..F::WIDTH {
+            if bits >> i & 1 != 0 {
+                let (k, pm) = self.table.sample(u_select.lane(i));
+                (which[i], pmf[i]) = (k as u32, pm);
+            }
+        }
+        let pmf = F::load(&pmf);
+        let mut todo = bits;
+        while todo != 0 {
+            let k = which[todo.trailing_zeros() as usize];
+            let mut group = 0u32;
+            for (i, &w) in which.iter().enumerate().take(F::WIDTH) {
+                if todo >> i & 1 != 0 && w == k {
+                    group |= 1 << i;
+                }
+            }
+            todo &= !group;
+            let gm = M::<F>::from_fn(|i| group >> i & 1 != 0);
+            if let Some(s) = self.rect_lanes::<F, MOTION>(prims, k, p, gm, pmf, ux, uy, textures) {
+                out.blend(gm, &s);
+                continue;
+            }
+            for i in 0..F::WIDTH {
+                if group >> i & 1 == 0 {
+                    continue;
+                }
+                let u = glam::Vec2::new(ux.lane(i), uy.lane(i));
+                let s = self.sample::<MOTION>(
+                    prims,
+                    p.lane(i),
+                    u_select.lane(i),
+                    u,
+                    time.lane(i),
+                    textures,
+                );
+                let lane = M::<F>::from_fn(|l| l == i);
+                let Some(s) = s else {
+                    out.has = out.has.and_not(lane);
+                    continue;
+                };
+                let (q, nq) = s.point.unwrap_or_default();
+                let one = LaneLightSample {
+                    has: M::<F>::splat(true),
+                    wi: V3::splat(s.wi),
+                    radiance: V3::splat(s.radiance),
+                    pdf: F::splat(s.pdf),
+                    delta: M::<F>::splat(s.delta),
+                    at_point: M::<F>::splat(s.point.is_some()),
+                    q: V3::splat(q),
+                    nq: V3::splat(nq),
+                };
+                out.blend(lane, &one);
+            }
+        }
+        out
+    }
+
+    /// Light `k` sampled in lanes `m`, if it is a still, untextured rectangle.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn rect_lanes<F: Float, const MOTION: bool>(
+        &self,
+        prims: &Primitives,
+        k: u32,
+        p: V3<F>,
+        m: M<F>,
+        pmf: F,
+        ux: F,
+        uy: F,
+        textures: bool,
+    ) -> Option<LaneLightSample<F>> {
+        let LightKind::Area(prim) = self.lights[k as usize] else {
+            return None;
+        };
+        let i = prim as usize;
+        if prims.kind[i] != PrimKind::Rect
+            || (MOTION && prims.motion[i] != NO_MOTION)
+            || (textures && prims.texture_of(prim).is_some())
+        {
+            return None;
+        }
+        let Material::Light {
+            emission,
+            two_sided,
+            ..
+        } = prims.materials[prims.material[i] as usize]
+        else {
+            return None;
+        };
+        let rect = &prims.planars[prims.local[i] as usize];
+        let (q, pdf) = rect.sample_rect_lanes(p, ux, uy);
+        let d = q - p;
+        // glam's `normalize_or_zero`.
+        let rcp = (d.x * d.x + d.y * d.y + d.z * d.z).sqrt().recip();
+        let unit = rcp.is_finite() & rcp.gt(F::zero());
+        let wi = V3::select(unit, d * rcp, V3::zero());
+        let n = V3::<F>::splat(rect.n);
+        let facing = if two_sided {
+            M::<F>::splat(true)
+        } else {
+            let wo = -wi;
+            (n.x * wo.x + n.y * wo.y + n.z * wo.z).gt(F::zero())
+        };
+        let lit = M::<F>::splat(emission != glam::Vec3::ZERO) & facing;
+        Some(LaneLightSample {
+            has: m & pdf.gt(F::zero()) & nonzero(wi) & lit,
+            wi,
+            radiance: V3::splat(emission),
+            pdf: pmf * pdf,
+            delta: M::<F>::splat(false),
+            at_point: M::<F>::splat(true),
+            q,
+            nq: n,
+        })
+    }
+}
