@@ -67,7 +67,7 @@ fn every_width_renders_every_shipped_scene_alike() {
                     "{name}: fell back to width 1 without an uncovered effect"
                 );
                 println!(
-                    "{name} at {}: ran at width 1 (SPECTRAL or MEDIA, not in the packet kernel yet)",
+                    "{name} at {}: ran at width 1 (MEDIA, not in the packet kernel yet)",
                     lanes.describe()
                 );
                 continue;

@@ -15,6 +15,7 @@ pub mod wavefront;
 use crate::systems::{Effect, RenderScene};
 use glam::Vec3;
 use rayon::prelude::*;
+use std::marker::PhantomData;
 use std::time::Instant;
 
 pub use path::Ctx;
@@ -120,20 +121,30 @@ thread_local! {
         std::cell::RefCell::new(wavefront::Queues::default());
 }
 
-/// This thread's reusable queues for a transport.
+/// This thread's reusable queues for a transport, and its packet kernel.
 trait WithQueues: transport::Transport {
     fn with_queues<R>(f: impl FnOnce(&mut wavefront::Queues<Self>) -> R) -> R;
+    /// [`packet::render_tile`] with this transport's channel count.
+    fn packet_tile<F: crate::simd::Float, const MOTION: bool>(t: PacketTile<'_, '_, MOTION>);
 }
 
 impl WithQueues for transport::Rgb {
     fn with_queues<R>(f: impl FnOnce(&mut wavefront::Queues<Self>) -> R) -> R {
         QUEUES_RGB.with_borrow_mut(f)
     }
+    #[inline(always)]
+    fn packet_tile<F: crate::simd::Float, const MOTION: bool>(t: PacketTile<'_, '_, MOTION>) {
+        packet::render_tile::<F, Self, 3, MOTION>(t.ctx, t.tile, t.s0, t.s1, t.film, t.stats)
+    }
 }
 
 impl WithQueues for transport::Spectral {
     fn with_queues<R>(f: impl FnOnce(&mut wavefront::Queues<Self>) -> R) -> R {
         QUEUES_SPECTRAL.with_borrow_mut(f)
+    }
+    #[inline(always)]
+    fn packet_tile<F: crate::simd::Float, const MOTION: bool>(t: PacketTile<'_, '_, MOTION>) {
+        packet::render_tile::<F, Self, 4, MOTION>(t.ctx, t.tile, t.s0, t.s1, t.film, t.stats)
     }
 }
 
@@ -224,7 +235,7 @@ pub fn lanes_for(
     let fx = &scene.effects;
     if integrator == Integrator::Wavefront
         && asked.width() > 1
-        && packet::supports(fx.has(Effect::Spectral), fx.has(Effect::Media))
+        && packet::supports(fx.has(Effect::Media))
     {
         asked
     } else {
@@ -243,14 +254,14 @@ pub fn describe_lanes(scene: &RenderScene, asked: crate::simd::Lanes) -> String 
         )
     } else {
         format!(
-            "{}: the packet kernel does not cover SPECTRAL or MEDIA yet, so {} is not used",
+            "{}: the packet kernel does not cover MEDIA yet, so {} is not used",
             ran.describe(),
             asked.describe()
         )
     }
 }
 
-/// One tile's samples through the packet kernel, at the lane type `dispatch` picks.
+/// One tile's samples through the packet kernel.
 struct PacketTile<'a, 'c, const MOTION: bool> {
     ctx: &'a Ctx<'c>,
     tile: &'a Tile,
@@ -260,13 +271,16 @@ struct PacketTile<'a, 'c, const MOTION: bool> {
     stats: &'a mut RenderStats,
 }
 
-impl<const MOTION: bool> crate::simd::LaneKernel for PacketTile<'_, '_, MOTION> {
+/// A [`PacketTile`] in transport `T`, at the lane type `dispatch` picks.
+struct PacketKernel<'a, 'c, T, const MOTION: bool>(PacketTile<'a, 'c, MOTION>, PhantomData<T>);
+
+impl<T: WithQueues, const MOTION: bool> crate::simd::LaneKernel
+    for PacketKernel<'_, '_, T, MOTION>
+{
     type Output = ();
     #[inline(always)]
     fn run<F: crate::simd::Float>(self) {
-        packet::render_tile::<F, MOTION>(
-            self.ctx, self.tile, self.s0, self.s1, self.film, self.stats,
-        )
+        T::packet_tile::<F, MOTION>(self.0)
     }
 }
 
@@ -310,14 +324,17 @@ fn render_with<T: WithQueues, const MEDIA: bool, const MOTION: bool>(
                 match opts.integrator {
                     Integrator::Wavefront if packet => crate::simd::dispatch(
                         lanes,
-                        PacketTile::<MOTION> {
-                            ctx: &ctx,
-                            tile,
-                            s0,
-                            s1: s0 + n,
-                            film: &mut film,
-                            stats: &mut st,
-                        },
+                        PacketKernel::<T, MOTION>(
+                            PacketTile {
+                                ctx: &ctx,
+                                tile,
+                                s0,
+                                s1: s0 + n,
+                                film: &mut film,
+                                stats: &mut st,
+                            },
+                            PhantomData,
+                        ),
                     ),
                     Integrator::Wavefront => T::with_queues(|q| {
                         crate::simd::scalar_entry(

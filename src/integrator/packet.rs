@@ -13,12 +13,14 @@
 //! the kd-tree walk and primitive tests, surface reconstruction with its texture lookups,
 //! light-sample geometry and the shadow rays' any-hit walk.
 //!
-//! Covers RGB transport without media, with or without MOTION, LENS, TEXTURES and
-//! NORMAL_MAPS; the other variants run the per-path integrator (`super::packet_supports`).
+//! Covers RGB and spectral transport without media, with or without MOTION, LENS, TEXTURES
+//! and NORMAL_MAPS; media run the per-path integrator (`supports`). Spectral paths carry four
+//! channels (`Chan<F, 4>`, one per hero wavelength) and keep their wavelengths per lane, where
+//! the per-lane stages evaluate the scene's spectra with the scalar transport's functions.
 
 use super::bsdf::{Chan, Dielectric, Diffuse, Frame, LaneChannels, Mirror, Mode};
 use super::path::{self, Ctx, DIM_BOUNCE, DIMS_PER_BOUNCE, camera_rays, surface_material};
-use super::transport::{Rgb, Transport};
+use super::transport::{ChannelArray, Transport};
 use super::{RenderStats, Tile};
 use crate::components::Material;
 use crate::geometry::{Ray, offset_ray_origin_lanes};
@@ -27,12 +29,14 @@ use crate::systems::light_lanes::LaneLightSample;
 use crate::systems::primitives::emitted;
 use glam::Vec3;
 
-type C3<F> = Chan<F, 3>;
 type U<F> = <F as Float>::U32;
 type M<F> = <F as Float>::Mask;
 
 /// The widest packet: scratch arrays for per-lane work are this long.
 const MAX_W: usize = 16;
+
+/// Channels of lanes: N = 3 for RGB, 4 for spectral.
+type C<F, const N: usize> = Chan<F, N>;
 
 /// Per-lane material classes after the surface stage.
 const CLASS_NONE: u32 = 0;
@@ -41,12 +45,13 @@ const CLASS_MIRROR: u32 = 2;
 const CLASS_DIELECTRIC: u32 = 3;
 
 /// The state of `F::WIDTH` paths, one per lane. Dead lanes hold stale values until refilled.
-#[derive(Clone, Copy)]
-struct Paths<F: Float> {
+struct Paths<F: Float, T: Transport, const N: usize> {
     o: V3<F>,
     d: V3<F>,
-    beta: C3<F>,
-    l: C3<F>,
+    beta: C<F, N>,
+    l: C<F, N>,
+    /// Each lane's wavelengths (nothing in RGB).
+    lam: [T::Lambda; MAX_W],
     eta_scale: F,
     depth: U<F>,
     specular: M<F>,
@@ -59,7 +64,7 @@ struct Paths<F: Float> {
 }
 
 /// What the surface stage found at each lane's hit point.
-struct Surface<F: Float> {
+struct Surface<F: Float, const N: usize> {
     hit: M<F>,
     p: V3<F>,
     /// Geometric and shading normals on the side the ray arrived from.
@@ -68,12 +73,12 @@ struct Surface<F: Float> {
     front: M<F>,
     class: U<F>,
     /// Albedo (Diffuse) or tint (Mirror), texture-modulated.
-    color: C3<F>,
-    /// A dielectric's IOR (outside over inside).
-    ior: F,
+    color: C<F, N>,
+    /// Each lane's material index (for a dielectric's IOR model).
+    mat: [u32; MAX_W],
     /// Lanes that hit an emitter with non-zero radiance, the radiance and its MIS weight.
     emits: M<F>,
-    le: C3<F>,
+    le: C<F, N>,
     le_w: F,
 }
 
@@ -83,13 +88,34 @@ fn mask_from_bits<F: Float>(bits: u32) -> M<F> {
 }
 
 #[inline(always)]
-fn select_c3<F: Float>(m: M<F>, a: C3<F>, b: C3<F>) -> C3<F> {
+fn select_c<F: Float, const N: usize>(m: M<F>, a: C<F, N>, b: C<F, N>) -> C<F, N> {
     Chan(std::array::from_fn(|c| F::select(m, a.0[c], b.0[c])))
 }
 
+/// Lane `i` of channels `c` as the scalar transport's channels.
 #[inline(always)]
-fn c3_lane<F: Float>(c: &C3<F>, i: usize) -> Vec3 {
-    Vec3::new(c.0[0].lane(i), c.0[1].lane(i), c.0[2].lane(i))
+fn chan_lane<F: Float, S: ChannelArray<N>, const N: usize>(c: &C<F, N>, i: usize) -> S {
+    S::from_array(std::array::from_fn(|k| c.0[k].lane(i)))
+}
+
+/// Channels gathered one lane at a time, loaded into lanes afterwards.
+struct ScratchC<const N: usize>([[f32; MAX_W]; N]);
+
+impl<const N: usize> ScratchC<N> {
+    #[inline(always)]
+    fn new() -> Self {
+        ScratchC([[0.0; MAX_W]; N])
+    }
+    #[inline(always)]
+    fn set<S: ChannelArray<N>>(&mut self, i: usize, v: S) {
+        for (k, c) in v.to_array().into_iter().enumerate() {
+            self.0[k][i] = c;
+        }
+    }
+    #[inline(always)]
+    fn load<F: Float>(&self) -> C<F, N> {
+        Chan(std::array::from_fn(|k| F::load(&self.0[k])))
+    }
 }
 
 /// Per-lane results gathered one lane at a time, loaded into lanes afterwards.
@@ -115,10 +141,6 @@ impl Scratch3 {
     #[inline(always)]
     fn v3<F: Float>(&self) -> V3<F> {
         V3::new(F::load(&self.x), F::load(&self.y), F::load(&self.z))
-    }
-    #[inline(always)]
-    fn c3<F: Float>(&self) -> C3<F> {
-        Chan([F::load(&self.x), F::load(&self.y), F::load(&self.z)])
     }
 }
 
@@ -161,19 +183,20 @@ fn power_heuristic<F: Float>(a: F, b: F) -> F {
 /// Starts new paths in the dead lanes, from the tile's next samples (pixel-major, as the
 /// per-path integrator orders them).
 #[inline(always)]
-fn refill<F: Float, const MOTION: bool>(
+fn refill<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
     ctx: &Ctx,
     tile: &Tile,
     s0: u32,
     spp: usize,
     total: usize,
     next: &mut usize,
-    st: &mut Paths<F>,
+    st: &mut Paths<F, T, N>,
 ) {
     let mut x = [0u32; MAX_W];
     let mut y = [0u32; MAX_W];
     let mut idx = [0u32; MAX_W];
     let mut fresh = 0u32;
+    let mut beta0 = ScratchC::<N>::new();
     let alive = st.alive.bits();
     for i in 0..F::WIDTH {
         if alive >> i & 1 == 0 && *next < total {
@@ -182,6 +205,11 @@ fn refill<F: Float, const MOTION: bool>(
             idx[i] = s0 + k as u32;
             fresh |= 1 << i;
             *next += 1;
+            if T::SPECTRAL {
+                let lam = T::wavelengths(ctx, y[i] * ctx.width + x[i], idx[i]);
+                beta0.set(i, T::initial_beta(&lam));
+                st.lam[i] = lam;
+            }
         }
     }
     if fresh == 0 {
@@ -197,8 +225,13 @@ fn refill<F: Float, const MOTION: bool>(
     st.o = V3::select(fm, cam.o, st.o);
     st.d = V3::select(fm, cam.d, st.d);
     st.time = F::select(fm, cam.time, st.time);
-    st.beta = select_c3(fm, C3::<F>::splat(F::one()), st.beta);
-    st.l = select_c3(fm, C3::<F>::splat(F::zero()), st.l);
+    let beta0 = if T::SPECTRAL {
+        beta0.load()
+    } else {
+        C::<F, N>::splat(F::one())
+    };
+    st.beta = select_c(fm, beta0, st.beta);
+    st.l = select_c(fm, C::<F, N>::splat(F::zero()), st.l);
     st.eta_scale = F::select(fm, F::one(), st.eta_scale);
     st.depth = U::<F>::select(fm, U::<F>::splat(0), st.depth);
     st.specular = st.specular.and_not(fm);
@@ -210,23 +243,39 @@ fn refill<F: Float, const MOTION: bool>(
     st.alive |= fm;
 }
 
-impl<F: Float> C3<F> {
+impl<F: Float, const N: usize> C<F, N> {
     #[inline(always)]
     fn is_zero(&self) -> M<F> {
-        self.0[0].eq(F::zero()) & self.0[1].eq(F::zero()) & self.0[2].eq(F::zero())
+        let mut z = self.0[0].eq(F::zero());
+        for c in &self.0[1..] {
+            z &= c.eq(F::zero());
+        }
+        z
+    }
+    /// The largest channel (the scalar `max_element`).
+    #[inline(always)]
+    fn max_element(&self) -> F {
+        let mut m = self.0[0];
+        for &c in &self.0[1..] {
+            m = m.max(c);
+        }
+        m
     }
 }
 
 /// Closest hits and what lies there, one lane at a time: the kd walk, the surface, its
 /// textures and material, and for emitters their radiance with its MIS weight.
 #[inline(always)]
-fn surfaces<F: Float, const MOTION: bool>(ctx: &Ctx, st: &Paths<F>) -> Surface<F> {
+fn surfaces<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
+    ctx: &Ctx,
+    st: &Paths<F, T, N>,
+) -> Surface<F, N> {
     let scene = ctx.scene;
     let prims = &scene.prims;
     let (mut p, mut n, mut ns) = (Scratch3::new(), Scratch3::new(), Scratch3::new());
-    let (mut color, mut le) = (Scratch3::new(), Scratch3::new());
+    let (mut color, mut le) = (ScratchC::<N>::new(), ScratchC::<N>::new());
     let mut class = [CLASS_NONE; MAX_W];
-    let mut ior = [1.0f32; MAX_W];
+    let mut mats = [0u32; MAX_W];
     let mut le_w = [0.0f32; MAX_W];
     let (mut hit_bits, mut front_bits, mut emit_bits) = (0u32, 0u32, 0u32);
     let hits = scene.intersect_packet::<F, MOTION>(st.o, st.d, st.alive, st.time);
@@ -241,7 +290,10 @@ fn surfaces<F: Float, const MOTION: bool>(ctx: &Ctx, st: &Paths<F>) -> Surface<F
             continue;
         };
         hit_bits |= 1 << i;
-        let (sp, material, _) = surface_material::<MOTION>(ctx, &ray, &hit, time);
+        let mat = prims.material[hit.prim as usize];
+        mats[i] = mat;
+        let (sp, material, tex_albedo) = surface_material::<MOTION>(ctx, &ray, &hit, time);
+        let lam = &st.lam[i];
         p.set(i, sp.p);
         n.set(i, sp.facing());
         ns.set(i, sp.shading_facing());
@@ -249,22 +301,21 @@ fn surfaces<F: Float, const MOTION: bool>(ctx: &Ctx, st: &Paths<F>) -> Surface<F
         match material {
             Material::Diffuse { albedo } => {
                 class[i] = CLASS_DIFFUSE;
-                color.set(i, albedo);
+                color.set(
+                    i,
+                    T::reflectance(ctx, mat, albedo, tex_albedo.is_some(), lam),
+                );
             }
             Material::Mirror { tint } => {
                 class[i] = CLASS_MIRROR;
-                color.set(i, tint);
+                color.set(i, T::reflectance(ctx, mat, tint, tex_albedo.is_some(), lam));
             }
-            Material::Dielectric { ior: model } => {
-                class[i] = CLASS_DIELECTRIC;
-                let mut unused = Vec3::ONE;
-                ior[i] = Rgb::eta(&model, &mut (), &mut unused);
-            }
+            Material::Dielectric { .. } => class[i] = CLASS_DIELECTRIC,
             Material::Light { .. } => {
                 let radiance = emitted(&material, sp.n, -ray.d);
                 if radiance != Vec3::ZERO {
                     emit_bits |= 1 << i;
-                    le.set(i, radiance);
+                    le.set(i, T::emission(ctx, mat, radiance, tex_albedo, lam));
                     let (depth, specular) = (st.depth.lane(i), st.specular.lane(i));
                     le_w[i] = if depth == 0 || specular || !ctx.nee {
                         1.0
@@ -291,10 +342,10 @@ fn surfaces<F: Float, const MOTION: bool>(ctx: &Ctx, st: &Paths<F>) -> Surface<F
         nsf: ns.v3(),
         front: mask_from_bits::<F>(front_bits),
         class: U::<F>::from_fn(|i| class[i]),
-        color: color.c3(),
-        ior: F::load(&ior),
+        color: color.load(),
+        mat: mats,
         emits: mask_from_bits::<F>(emit_bits),
-        le: le.c3(),
+        le: le.load(),
         le_w: F::load(&le_w),
     }
 }
@@ -302,10 +353,10 @@ fn surfaces<F: Float, const MOTION: bool>(ctx: &Ctx, st: &Paths<F>) -> Surface<F
 /// Next-event estimation at the diffuse lanes `dm`: a light sample per lane, its BSDF value
 /// and MIS weight over lanes, then a shadow ray per lane whose contribution is not zero.
 #[inline(always)]
-fn light_samples<F: Float, const MOTION: bool>(
+fn light_samples<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
     ctx: &Ctx,
-    st: &mut Paths<F>,
-    sf: &Surface<F>,
+    st: &mut Paths<F, T, N>,
+    sf: &Surface<F, N>,
     dm: M<F>,
     frame: &Frame<F>,
     dim: U<F>,
@@ -327,6 +378,7 @@ fn light_samples<F: Float, const MOTION: bool>(
         uy,
         st.time,
         ctx.textures,
+        T::SPECTRAL,
     );
     let wi = ls.wi;
     let wi_l = frame.to_local(wi);
@@ -340,14 +392,28 @@ fn light_samples<F: Float, const MOTION: bool>(
     let f = bsdf.eval(wo_l, wi_l) * cos;
     let pdf = ls.pdf;
     let w = F::select(ls.delta, F::one(), power_heuristic(pdf, bsdf_pdf));
-    let rad = Chan([ls.radiance.x, ls.radiance.y, ls.radiance.z]);
+    let rad = if T::SPECTRAL {
+        let mut rad = ScratchC::<N>::new();
+        let bits = ok.bits();
+        for i in 0..F::WIDTH {
+            if bits >> i & 1 != 0 {
+                let rgb = ls.radiance.lane(i);
+                rad.set(i, T::source_radiance(ctx, &ls.sources[i], rgb, &st.lam[i]));
+            }
+        }
+        rad.load()
+    } else {
+        // RGB: N = 3.
+        let r = [ls.radiance.x, ls.radiance.y, ls.radiance.z];
+        Chan(std::array::from_fn(|k| r[k]))
+    };
     let contrib = st.beta * f * rad * (w / pdf);
     let shoot = ok & !contrib.is_zero();
     let (so, sd, t_max) = shadow_rays(sf.p, sf.nf, &ls);
     stats.shadow_rays += u64::from(shoot.count());
     let blocked = scene.occluded_packet::<F, MOTION>(so, sd, shoot, t_max, st.time);
     let lit = shoot.and_not(blocked);
-    st.l = select_c3(lit, st.l + contrib, st.l);
+    st.l = select_c(lit, st.l + contrib, st.l);
 }
 
 /// `path::shadow_ray_from_surface` over lanes: towards the sampled point of an area light
@@ -380,7 +446,12 @@ fn shadow_rays<F: Float>(p: V3<F>, nf: V3<F>, ls: &LaneLightSample<F>) -> (V3<F>
 /// Renders samples `s0..s1` of every pixel of `tile` with packets of `F::WIDTH` paths, adding
 /// each finished path's radiance to `film` (the tile's pixels, row-major).
 #[inline(always)]
-pub fn render_tile<F: Float, const MOTION: bool>(
+pub fn render_tile<
+    F: Float,
+    T: Transport<S: ChannelArray<N>>,
+    const N: usize,
+    const MOTION: bool,
+>(
     ctx: &Ctx,
     tile: &Tile,
     s0: u32,
@@ -392,11 +463,12 @@ pub fn render_tile<F: Float, const MOTION: bool>(
     let total = tile.pixels() * spp;
     let mut next = 0usize;
     let zero3 = V3::<F>::zero();
-    let mut st = Paths::<F> {
+    let mut st = Paths::<F, T, N> {
         o: zero3,
         d: zero3,
-        beta: C3::<F>::splat(F::zero()),
-        l: C3::<F>::splat(F::zero()),
+        beta: C::<F, N>::splat(F::zero()),
+        l: C::<F, N>::splat(F::zero()),
+        lam: [T::Lambda::default(); MAX_W],
         eta_scale: F::one(),
         depth: U::<F>::splat(0),
         specular: M::<F>::splat(false),
@@ -411,14 +483,14 @@ pub fn render_tile<F: Float, const MOTION: bool>(
     let env = scene.environment;
     let max_depth = U::<F>::splat(ctx.max_depth);
     loop {
-        refill::<F, MOTION>(ctx, tile, s0, spp, total, &mut next, &mut st);
+        refill::<F, T, N, MOTION>(ctx, tile, s0, spp, total, &mut next, &mut st);
         let started = st.alive;
         if started.none() {
             break;
         }
         stats.rays += started.count() as u64;
         stats.lane_slots += F::WIDTH as u64;
-        let sf = surfaces::<F, MOTION>(ctx, &st);
+        let sf = surfaces::<F, T, N, MOTION>(ctx, &st);
         // Misses see the environment.
         let miss = started.and_not(sf.hit);
         if env != Vec3::ZERO && miss.any() {
@@ -428,28 +500,35 @@ pub fn render_tile<F: Float, const MOTION: bool>(
                 F::one(),
                 power_heuristic(st.prev_pdf, F::splat(scene.lights.pdf_environment())),
             );
-            let e = Chan([F::splat(env.x), F::splat(env.y), F::splat(env.z)]);
-            st.l = select_c3(miss, st.l + st.beta * e * w, st.l);
+            let e = if T::SPECTRAL {
+                let mut e = ScratchC::<N>::new();
+                let bits = miss.bits();
+                for i in 0..F::WIDTH {
+                    if bits >> i & 1 != 0 {
+                        e.set(i, T::environment(ctx, &st.lam[i]));
+                    }
+                }
+                e.load()
+            } else {
+                // RGB: N = 3.
+                let e = [env.x, env.y, env.z];
+                Chan(std::array::from_fn(|k| F::splat(e[k])))
+            };
+            st.l = select_c(miss, st.l + st.beta * e * w, st.l);
         }
         // Emitters add their radiance and absorb the rest.
-        st.l = select_c3(sf.emits, st.l + st.beta * sf.le * sf.le_w, st.l);
+        st.l = select_c(sf.emits, st.l + st.beta * sf.le * sf.le_w, st.l);
         let scatters = !sf.class.eq(U::<F>::splat(CLASS_NONE));
         st.alive = started & sf.hit & scatters & st.depth.lt(max_depth);
         if st.alive.any() {
-            scatter::<F, MOTION>(ctx, &mut st, &sf, stats);
+            scatter::<F, T, N, MOTION>(ctx, &mut st, &sf, stats);
         }
         // Finished paths go to the film.
         let ended = started.and_not(st.alive).bits();
         for i in 0..F::WIDTH {
             if ended >> i & 1 != 0 {
-                super::accumulate(
-                    film,
-                    tile,
-                    ctx.width,
-                    st.pixel.lane(i),
-                    c3_lane(&st.l, i),
-                    stats,
-                );
+                let l = T::to_rgb(chan_lane(&st.l, i), &st.lam[i]);
+                super::accumulate(film, tile, ctx.width, st.pixel.lane(i), l, stats);
             }
         }
     }
@@ -458,10 +537,10 @@ pub fn render_tile<F: Float, const MOTION: bool>(
 /// One scattering event in every live lane: light samples at diffuse lanes, then a BSDF
 /// sample per material class present, then Russian roulette.
 #[inline(always)]
-fn scatter<F: Float, const MOTION: bool>(
+fn scatter<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
     ctx: &Ctx,
-    st: &mut Paths<F>,
-    sf: &Surface<F>,
+    st: &mut Paths<F, T, N>,
+    sf: &Surface<F, N>,
     stats: &mut RenderStats,
 ) {
     let live = st.alive;
@@ -481,7 +560,7 @@ fn scatter<F: Float, const MOTION: bool>(
     let mut scattered = M::<F>::splat(false);
     if dm.any() {
         if ctx.nee {
-            light_samples::<F, MOTION>(ctx, st, sf, dm, &frame, dim, stats);
+            light_samples::<F, T, N, MOTION>(ctx, st, sf, dm, &frame, dim, stats);
         }
         let (ux, uy) =
             ctx.sampler
@@ -491,7 +570,7 @@ fn scatter<F: Float, const MOTION: bool>(
         // Sampled around a tilted shading normal into the geometric back side: absorbed.
         let ok = dm & gdot(wi, sf.nf).gt(F::zero());
         st.alive = st.alive.and_not(dm.and_not(ok));
-        st.beta = select_c3(ok, st.beta * bs.weight, st.beta);
+        st.beta = select_c(ok, st.beta * bs.weight, st.beta);
         st.prev_pdf = F::select(ok, bs.pdf, st.prev_pdf);
         st.specular = st.specular.and_not(ok);
         st.o = V3::select(ok, up, st.o);
@@ -500,7 +579,7 @@ fn scatter<F: Float, const MOTION: bool>(
     }
     if mm.any() {
         let bs = Mirror { tint: sf.color }.sample(wo_l);
-        st.beta = select_c3(mm, st.beta * bs.weight, st.beta);
+        st.beta = select_c(mm, st.beta * bs.weight, st.beta);
         st.specular |= mm;
         let wi = frame.to_world(bs.wi);
         st.o = V3::select(mm, up, st.o);
@@ -508,7 +587,27 @@ fn scatter<F: Float, const MOTION: bool>(
         scattered |= mm;
     }
     if em.any() {
-        let eta = F::select(sf.front, sf.ior, sf.ior.recip());
+        // The IOR per lane; a dispersive one ends the lane's secondary wavelengths.
+        let prims = &ctx.scene.prims;
+        let mut ior = [1.0f32; MAX_W];
+        let mut beta = ScratchC::<N>::new();
+        let bits = em.bits();
+        for (i, n) in ior.iter_mut().enumerate().take(F::WIDTH) {
+            if bits >> i & 1 != 0 {
+                let Material::Dielectric { ior: model } = prims.materials[sf.mat[i] as usize]
+                else {
+                    continue;
+                };
+                let mut b: T::S = chan_lane(&st.beta, i);
+                *n = T::eta(&model, &mut st.lam[i], &mut b);
+                beta.set(i, b);
+            }
+        }
+        if T::SPECTRAL {
+            st.beta = select_c(em, beta.load(), st.beta);
+        }
+        let ior = F::load(&ior);
+        let eta = F::select(sf.front, ior, ior.recip());
         let u =
             ctx.sampler
                 .get_1d_lanes::<F>(st.pixel, st.sample, dim.wrapping_add(U::<F>::splat(3)));
@@ -516,9 +615,9 @@ fn scatter<F: Float, const MOTION: bool>(
             eta,
             schlick: ctx.schlick,
         };
-        let bs = bsdf.sample::<C3<F>>(wo_l, u, Mode::Radiance);
+        let bs = bsdf.sample::<C<F, N>>(wo_l, u, Mode::Radiance);
         st.specular |= em;
-        st.beta = select_c3(em, st.beta * bs.weight, st.beta);
+        st.beta = select_c(em, st.beta * bs.weight, st.beta);
         let wi = frame.to_world(bs.wi);
         let t = em & bs.is_transmission();
         st.eta_scale = F::select(t, st.eta_scale * (bs.eta * bs.eta), st.eta_scale);
@@ -535,11 +634,15 @@ fn scatter<F: Float, const MOTION: bool>(
 
 /// `path::russian_roulette` over lanes, for the lanes in `m`.
 #[inline(always)]
-fn russian_roulette<F: Float>(ctx: &Ctx, st: &mut Paths<F>, m: M<F>, dim: U<F>) {
+fn russian_roulette<F: Float, T: Transport, const N: usize>(
+    ctx: &Ctx,
+    st: &mut Paths<F, T, N>,
+    m: M<F>,
+    dim: U<F>,
+) {
     let deep = m & !st.depth.lt(U::<F>::splat(ctx.rr_depth));
     if deep.any() {
-        let b = st.beta.0.map(|c| c * st.eta_scale);
-        let rr = b[0].max(b[1]).max(b[2]);
+        let rr = (st.beta * st.eta_scale).max_element();
         let low = deep & rr.lt(F::one());
         if low.any() {
             let q = (F::one() - rr).max(F::zero());
@@ -548,13 +651,13 @@ fn russian_roulette<F: Float>(ctx: &Ctx, st: &mut Paths<F>, m: M<F>, dim: U<F>) 
             st.alive = st.alive.and_not(kill);
             let keep = low.and_not(kill);
             let k = F::one() - q;
-            st.beta = select_c3(keep, Chan(st.beta.0.map(|c| c / k)), st.beta);
+            st.beta = select_c(keep, Chan(st.beta.0.map(|c| c / k)), st.beta);
         }
     }
     st.alive = st.alive.and_not(m & st.beta.is_zero());
 }
 
-/// Which effect variants the packet kernel runs: RGB transport without media.
-pub fn supports(spectral: bool, media: bool) -> bool {
-    !spectral && !media
+/// Which effect variants the packet kernel runs: RGB or spectral transport without media.
+pub fn supports(media: bool) -> bool {
+    !media
 }

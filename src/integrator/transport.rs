@@ -212,8 +212,39 @@ impl SpectralData {
     }
 }
 
+/// A transport's channels as a plain array, to move them in and out of lanes.
+pub trait ChannelArray<const N: usize>: Channels {
+    fn to_array(self) -> [f32; N];
+    fn from_array(a: [f32; N]) -> Self;
+}
+
+impl ChannelArray<3> for Vec3 {
+    #[inline(always)]
+    fn to_array(self) -> [f32; 3] {
+        self.into()
+    }
+    #[inline(always)]
+    fn from_array(a: [f32; 3]) -> Self {
+        a.into()
+    }
+}
+
+impl ChannelArray<4> for SampledSpectrum {
+    #[inline(always)]
+    fn to_array(self) -> [f32; 4] {
+        self.0
+    }
+    #[inline(always)]
+    fn from_array(a: [f32; 4]) -> Self {
+        SampledSpectrum(a)
+    }
+}
+
 /// What a path carries, and how the scene's colours become that.
 pub trait Transport: Copy + Send + Sync + 'static {
+    /// Colours depend on the path's wavelengths (so the packet kernel evaluates them per lane;
+    /// RGB colours are the same for every lane).
+    const SPECTRAL: bool;
     type S: Channels;
     /// The path's wavelengths (nothing in RGB).
     type Lambda: Copy + std::fmt::Debug + Default + Send + Sync;
@@ -226,7 +257,12 @@ pub trait Transport: Copy + Send + Sync + 'static {
     fn reflectance(ctx: &Ctx, mat: u32, rgb: Vec3, textured: bool, lam: &Self::Lambda) -> Self::S;
     /// Radiance `le` (RGB, already texture-modulated by `tex`) of emitter material `mat`.
     fn emission(ctx: &Ctx, mat: u32, le: Vec3, tex: Option<Vec3>, lam: &Self::Lambda) -> Self::S;
-    fn light_radiance(ctx: &Ctx, ls: &LightSample, lam: &Self::Lambda) -> Self::S;
+    #[inline]
+    fn light_radiance(ctx: &Ctx, ls: &LightSample, lam: &Self::Lambda) -> Self::S {
+        Self::source_radiance(ctx, &ls.source, ls.radiance, lam)
+    }
+    /// The radiance `rgb` of a light sample from `source`.
+    fn source_radiance(ctx: &Ctx, source: &LightSource, rgb: Vec3, lam: &Self::Lambda) -> Self::S;
     /// A point light's intensity times `scale` (falloff / d²).
     fn point_radiance(ctx: &Ctx, light: u32, rgb: Vec3, scale: f32, lam: &Self::Lambda) -> Self::S;
     fn environment(ctx: &Ctx, lam: &Self::Lambda) -> Self::S;
@@ -243,6 +279,7 @@ pub trait Transport: Copy + Send + Sync + 'static {
 pub struct Rgb;
 
 impl Transport for Rgb {
+    const SPECTRAL: bool = false;
     type S = Vec3;
     type Lambda = ();
     type Med = HomogeneousMedium;
@@ -262,8 +299,8 @@ impl Transport for Rgb {
         le
     }
     #[inline]
-    fn light_radiance(_: &Ctx, ls: &LightSample, _: &()) -> Vec3 {
-        ls.radiance
+    fn source_radiance(_: &Ctx, _: &LightSource, rgb: Vec3, _: &()) -> Vec3 {
+        rgb
     }
     #[inline]
     fn point_radiance(_: &Ctx, _: u32, rgb: Vec3, scale: f32, _: &()) -> Vec3 {
@@ -300,6 +337,7 @@ fn sigmoid4(s: &RgbSigmoid, lam: &Wavelengths) -> SampledSpectrum {
 }
 
 impl Transport for Spectral {
+    const SPECTRAL: bool = true;
     type S = SampledSpectrum;
     type Lambda = Wavelengths;
     type Med = SpectralMedium;
@@ -352,13 +390,16 @@ impl Transport for Spectral {
         }
     }
     #[inline]
-    fn light_radiance(ctx: &Ctx, ls: &LightSample, lam: &Wavelengths) -> SampledSpectrum {
-        match ls.source {
-            LightSource::Area { material, tex, .. } => {
-                Self::emission(ctx, material, ls.radiance, tex, lam)
-            }
+    fn source_radiance(
+        ctx: &Ctx,
+        source: &LightSource,
+        rgb: Vec3,
+        lam: &Wavelengths,
+    ) -> SampledSpectrum {
+        match *source {
+            LightSource::Area { material, tex, .. } => Self::emission(ctx, material, rgb, tex, lam),
             LightSource::Point { light, scale } => {
-                Self::point_radiance(ctx, light, ls.radiance, scale, lam)
+                Self::point_radiance(ctx, light, rgb, scale, lam)
             }
             LightSource::Environment => Self::environment(ctx, lam),
         }

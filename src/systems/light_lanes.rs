@@ -5,7 +5,7 @@
 //! its room with one) are sampled in lanes, with the scalar sample's bits. Other lights, and
 //! rectangles that move or carry a texture, take [`Lights::sample`] one lane at a time.
 
-use super::lights::{LightKind, Lights};
+use super::lights::{LightKind, LightSource, Lights};
 use super::primitives::{NO_MOTION, PrimKind, Primitives};
 use crate::components::Material;
 use crate::simd::{Float, Mask, V3};
@@ -28,6 +28,9 @@ pub struct LaneLightSample<F: Float> {
     pub at_point: M<F>,
     pub q: V3<F>,
     pub nq: V3<F>,
+    /// Each lane's emitter, filled only when asked for (spectral transport evaluates its
+    /// spectrum from it).
+    pub sources: [LightSource; MAX_W],
 }
 
 impl<F: Float> LaneLightSample<F> {
@@ -43,6 +46,7 @@ impl<F: Float> LaneLightSample<F> {
             at_point: no,
             q: V3::zero(),
             nq: V3::zero(),
+            sources: [LightSource::Environment; MAX_W],
         }
     }
 
@@ -66,7 +70,8 @@ fn nonzero<F: Float>(v: V3<F>) -> M<F> {
 }
 
 impl Lights {
-    /// [`Lights::sample`] for the reference points of lanes `m`, with the same bits.
+    /// [`Lights::sample`] for the reference points of lanes `m`, with the same bits; with
+    /// `sources`, each lane's [`LightSource`] too.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
     pub fn sample_lanes<F: Float, const MOTION: bool>(
@@ -79,6 +84,7 @@ impl Lights {
         uy: F,
         time: F,
         textures: bool,
+        sources: bool,
     ) -> LaneLightSample<F> {
         let mut out = LaneLightSample::none();
         if self.lights.is_empty() || m.none() {
@@ -107,6 +113,18 @@ impl Lights {
             let gm = M::<F>::from_fn(|i| group >> i & 1 != 0);
             if let Some(s) = self.rect_lanes::<F, MOTION>(prims, k, p, gm, pmf, ux, uy, textures) {
                 out.blend(gm, &s);
+                if sources && let LightKind::Area(prim) = self.lights[k as usize] {
+                    let source = LightSource::Area {
+                        material: prims.material[prim as usize],
+                        tex: None,
+                        prim,
+                    };
+                    for i in 0..F::WIDTH {
+                        if group >> i & 1 != 0 {
+                            out.sources[i] = source;
+                        }
+                    }
+                }
                 continue;
             }
             for i in 0..F::WIDTH {
@@ -137,8 +155,12 @@ impl Lights {
                     at_point: M::<F>::splat(s.point.is_some()),
                     q: V3::splat(q),
                     nq: V3::splat(nq),
+                    sources: [LightSource::Environment; MAX_W],
                 };
                 out.blend(lane, &one);
+                if sources {
+                    out.sources[i] = s.source;
+                }
             }
         }
         out
@@ -200,6 +222,7 @@ impl Lights {
             at_point: M::<F>::splat(true),
             q,
             nq: n,
+            sources: [LightSource::Environment; MAX_W],
         })
     }
 }
