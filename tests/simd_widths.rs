@@ -8,7 +8,7 @@ mod common;
 
 use prism::integrator::{Integrator, RenderOptions, RenderOutput, render};
 use prism::simd::Lanes;
-use prism::systems::{Effect, RenderScene};
+use prism::systems::RenderScene;
 use std::path::Path;
 
 fn run(scene: &RenderScene, lanes: Lanes) -> RenderOutput {
@@ -58,20 +58,7 @@ fn every_width_renders_every_shipped_scene_alike() {
         assert_eq!(base.lanes.width(), 1);
         for &lanes in &widths {
             let out = run(&scene, lanes);
-            let fx = &scene.effects;
-            if out.lanes.width() == 1 {
-                // The packet kernel does not cover this effect set yet: it must say so by
-                // running, and reporting, width 1.
-                assert!(
-                    fx.has(Effect::Spectral) || fx.has(Effect::Media),
-                    "{name}: fell back to width 1 without an uncovered effect"
-                );
-                println!(
-                    "{name} at {}: ran at width 1 (MEDIA, not in the packet kernel yet)",
-                    lanes.describe()
-                );
-                continue;
-            }
+            // Every effect variant runs in the packet kernel at the width asked for.
             assert_eq!(out.lanes, lanes, "{name}");
             compared += 1;
             let img = out.image();

@@ -589,7 +589,7 @@ fn info(a: InfoArgs) -> Result<(), CliError> {
         s.filter
     );
     match crate::simd::Lanes::resolve(s.simd) {
-        Ok(lanes) => println!("simd: {}", integrator::describe_lanes(&rs, lanes)),
+        Ok(lanes) => println!("simd: {}", integrator::describe_lanes(lanes)),
         Err(e) => println!("simd: {e}"),
     }
     println!("entities: {}", rs.prims.len());

@@ -125,7 +125,9 @@ thread_local! {
 trait WithQueues: transport::Transport {
     fn with_queues<R>(f: impl FnOnce(&mut wavefront::Queues<Self>) -> R) -> R;
     /// [`packet::render_tile`] with this transport's channel count.
-    fn packet_tile<F: crate::simd::Float, const MOTION: bool>(t: PacketTile<'_, '_, MOTION>);
+    fn packet_tile<F: crate::simd::Float, const MOTION: bool, const MEDIA: bool>(
+        t: PacketTile<'_, '_, MOTION>,
+    );
 }
 
 impl WithQueues for transport::Rgb {
@@ -133,8 +135,10 @@ impl WithQueues for transport::Rgb {
         QUEUES_RGB.with_borrow_mut(f)
     }
     #[inline(always)]
-    fn packet_tile<F: crate::simd::Float, const MOTION: bool>(t: PacketTile<'_, '_, MOTION>) {
-        packet::render_tile::<F, Self, 3, MOTION>(t.ctx, t.tile, t.s0, t.s1, t.film, t.stats)
+    fn packet_tile<F: crate::simd::Float, const MOTION: bool, const MEDIA: bool>(
+        t: PacketTile<'_, '_, MOTION>,
+    ) {
+        packet::render_tile::<F, Self, 3, MOTION, MEDIA>(t.ctx, t.tile, t.s0, t.s1, t.film, t.stats)
     }
 }
 
@@ -143,8 +147,10 @@ impl WithQueues for transport::Spectral {
         QUEUES_SPECTRAL.with_borrow_mut(f)
     }
     #[inline(always)]
-    fn packet_tile<F: crate::simd::Float, const MOTION: bool>(t: PacketTile<'_, '_, MOTION>) {
-        packet::render_tile::<F, Self, 4, MOTION>(t.ctx, t.tile, t.s0, t.s1, t.film, t.stats)
+    fn packet_tile<F: crate::simd::Float, const MOTION: bool, const MEDIA: bool>(
+        t: PacketTile<'_, '_, MOTION>,
+    ) {
+        packet::render_tile::<F, Self, 4, MOTION, MEDIA>(t.ctx, t.tile, t.s0, t.s1, t.film, t.stats)
     }
 }
 
@@ -225,40 +231,23 @@ pub fn render(
     }
 }
 
-/// The lane width a render runs at: `asked` where the packet kernel covers the scene's
-/// effects and the wavefront integrator was asked for, else width 1.
-pub fn lanes_for(
-    scene: &RenderScene,
-    integrator: Integrator,
-    asked: crate::simd::Lanes,
-) -> crate::simd::Lanes {
-    let fx = &scene.effects;
-    if integrator == Integrator::Wavefront
-        && asked.width() > 1
-        && packet::supports(fx.has(Effect::Media))
-    {
+/// The lane width a render runs at: `asked` with the wavefront integrator (the packet
+/// kernel covers every effect variant), width 1 with the reference integrator.
+pub fn lanes_for(integrator: Integrator, asked: crate::simd::Lanes) -> crate::simd::Lanes {
+    if integrator == Integrator::Wavefront {
         asked
     } else {
         crate::simd::Lanes::scalar()
     }
 }
 
-/// What `lanes_for` decides, for `prism info`: the width and why.
-pub fn describe_lanes(scene: &RenderScene, asked: crate::simd::Lanes) -> String {
-    let ran = lanes_for(scene, Integrator::Wavefront, asked);
-    if ran == asked || asked.width() == 1 {
-        format!(
-            "{} (auto: {})",
-            ran.describe(),
-            crate::simd::Lanes::auto().describe()
-        )
-    } else {
-        format!(
-            "{}: the packet kernel does not cover MEDIA yet, so {} is not used",
-            ran.describe(),
-            asked.describe()
-        )
-    }
+/// The width a render runs at and the one `auto` picks, for `prism info`.
+pub fn describe_lanes(asked: crate::simd::Lanes) -> String {
+    format!(
+        "{} (auto: {})",
+        asked.describe(),
+        crate::simd::Lanes::auto().describe()
+    )
 }
 
 /// One tile's samples through the packet kernel.
@@ -272,15 +261,18 @@ struct PacketTile<'a, 'c, const MOTION: bool> {
 }
 
 /// A [`PacketTile`] in transport `T`, at the lane type `dispatch` picks.
-struct PacketKernel<'a, 'c, T, const MOTION: bool>(PacketTile<'a, 'c, MOTION>, PhantomData<T>);
+struct PacketKernel<'a, 'c, T, const MOTION: bool, const MEDIA: bool>(
+    PacketTile<'a, 'c, MOTION>,
+    PhantomData<T>,
+);
 
-impl<T: WithQueues, const MOTION: bool> crate::simd::LaneKernel
-    for PacketKernel<'_, '_, T, MOTION>
+impl<T: WithQueues, const MOTION: bool, const MEDIA: bool> crate::simd::LaneKernel
+    for PacketKernel<'_, '_, T, MOTION, MEDIA>
 {
     type Output = ();
     #[inline(always)]
     fn run<F: crate::simd::Float>(self) {
-        T::packet_tile::<F, MOTION>(self.0)
+        T::packet_tile::<F, MOTION, MEDIA>(self.0)
     }
 }
 
@@ -289,7 +281,7 @@ fn render_with<T: WithQueues, const MEDIA: bool, const MOTION: bool>(
     opts: &RenderOptions,
     progress: &(dyn Fn(u64) + Sync),
 ) -> RenderOutput {
-    let lanes = lanes_for(scene, opts.integrator, opts.lanes);
+    let lanes = lanes_for(opts.integrator, opts.lanes);
     let packet = lanes.width() > 1;
     let spectral = if scene.effects.has(Effect::Spectral) {
         transport::SpectralData::new(scene)
@@ -324,7 +316,7 @@ fn render_with<T: WithQueues, const MEDIA: bool, const MOTION: bool>(
                 match opts.integrator {
                     Integrator::Wavefront if packet => crate::simd::dispatch(
                         lanes,
-                        PacketKernel::<T, MOTION>(
+                        PacketKernel::<T, MOTION, MEDIA>(
                             PacketTile {
                                 ctx: &ctx,
                                 tile,

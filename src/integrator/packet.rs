@@ -19,14 +19,17 @@
 //! the per-lane stages evaluate the scene's spectra with the scalar transport's functions.
 
 use super::bsdf::{Chan, Dielectric, Diffuse, Frame, LaneChannels, Mirror, Mode};
-use super::path::{self, Ctx, DIM_BOUNCE, DIMS_PER_BOUNCE, camera_rays, surface_material};
-use super::transport::{ChannelArray, Transport};
+use super::path::{
+    self, Ctx, DIM_BOUNCE, DIMS_PER_BOUNCE, PathState, camera_rays, shade, surface_material,
+};
+use super::transport::{ChannelArray, MediumOps, Transport};
 use super::{RenderStats, Tile};
 use crate::components::Material;
 use crate::geometry::{Ray, offset_ray_origin_lanes};
 use crate::simd::{Float, Mask, UInt, V3};
 use crate::systems::light_lanes::LaneLightSample;
-use crate::systems::primitives::emitted;
+use crate::systems::packet::PacketHit;
+use crate::systems::primitives::{NO_MEDIUM, emitted};
 use glam::Vec3;
 
 type U<F> = <F as Float>::U32;
@@ -61,6 +64,10 @@ struct Paths<F: Float, T: Transport, const N: usize> {
     pixel: U<F>,
     sample: U<F>,
     alive: M<F>,
+    /// MEDIA: each lane's medium and medium segments so far (read only by the per-lane
+    /// vertex step).
+    medium: [u32; MAX_W],
+    segments: [u32; MAX_W],
 }
 
 /// What the surface stage found at each lane's hit point.
@@ -74,8 +81,13 @@ struct Surface<F: Float, const N: usize> {
     class: U<F>,
     /// Albedo (Diffuse) or tint (Mirror), texture-modulated.
     color: C<F, N>,
-    /// Each lane's material index (for a dielectric's IOR model).
+    /// Each lane's material index (for a dielectric's IOR model) and primitive (for the
+    /// medium behind a dielectric).
     mat: [u32; MAX_W],
+    prim: [u32; MAX_W],
+    /// MEDIA: lanes whose vertex runs per lane (in a medium, or at a medium's boundary); the
+    /// other fields do not describe them.
+    per_lane: M<F>,
     /// Lanes that hit an emitter with non-zero radiance, the radiance and its MIS weight.
     emits: M<F>,
     le: C<F, N>,
@@ -205,6 +217,8 @@ fn refill<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize, const MOTI
             idx[i] = s0 + k as u32;
             fresh |= 1 << i;
             *next += 1;
+            st.medium[i] = ctx.scene.camera_medium;
+            st.segments[i] = 0;
             if T::SPECTRAL {
                 let lam = T::wavelengths(ctx, y[i] * ctx.width + x[i], idx[i]);
                 beta0.set(i, T::initial_beta(&lam));
@@ -266,9 +280,16 @@ impl<F: Float, const N: usize> C<F, N> {
 /// Closest hits and what lies there, one lane at a time: the kd walk, the surface, its
 /// textures and material, and for emitters their radiance with its MIS weight.
 #[inline(always)]
-fn surfaces<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
+fn surfaces<
+    F: Float,
+    T: Transport<S: ChannelArray<N>>,
+    const N: usize,
+    const MOTION: bool,
+    const MEDIA: bool,
+>(
     ctx: &Ctx,
     st: &Paths<F, T, N>,
+    hits: &PacketHit<F>,
 ) -> Surface<F, N> {
     let scene = ctx.scene;
     let prims = &scene.prims;
@@ -276,11 +297,16 @@ fn surfaces<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize, const MO
     let (mut color, mut le) = (ScratchC::<N>::new(), ScratchC::<N>::new());
     let mut class = [CLASS_NONE; MAX_W];
     let mut mats = [0u32; MAX_W];
+    let mut prim = [0u32; MAX_W];
     let mut le_w = [0.0f32; MAX_W];
     let (mut hit_bits, mut front_bits, mut emit_bits) = (0u32, 0u32, 0u32);
-    let hits = scene.intersect_packet::<F, MOTION>(st.o, st.d, st.alive, st.time);
-    let found = hits.hit.bits();
+    let mut per_lane = 0u32;
+    let (alive, found) = (st.alive.bits(), hits.hit.bits());
     for i in 0..F::WIDTH {
+        if MEDIA && alive >> i & 1 != 0 && st.medium[i] != NO_MEDIUM {
+            per_lane |= 1 << i;
+            continue;
+        }
         if found >> i & 1 == 0 {
             continue;
         }
@@ -289,9 +315,14 @@ fn surfaces<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize, const MO
         let Some(hit) = hits.lane(i) else {
             continue;
         };
-        hit_bits |= 1 << i;
         let mat = prims.material[hit.prim as usize];
+        if MEDIA && let Material::Boundary = prims.materials[mat as usize] {
+            per_lane |= 1 << i;
+            continue;
+        }
+        hit_bits |= 1 << i;
         mats[i] = mat;
+        prim[i] = hit.prim;
         let (sp, material, tex_albedo) = surface_material::<MOTION>(ctx, &ray, &hit, time);
         let lam = &st.lam[i];
         p.set(i, sp.p);
@@ -344,6 +375,8 @@ fn surfaces<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize, const MO
         class: U::<F>::from_fn(|i| class[i]),
         color: color.load(),
         mat: mats,
+        prim,
+        per_lane: mask_from_bits::<F>(per_lane),
         emits: mask_from_bits::<F>(emit_bits),
         le: le.load(),
         le_w: F::load(&le_w),
@@ -353,7 +386,13 @@ fn surfaces<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize, const MO
 /// Next-event estimation at the diffuse lanes `dm`: a light sample per lane, its BSDF value
 /// and MIS weight over lanes, then a shadow ray per lane whose contribution is not zero.
 #[inline(always)]
-fn light_samples<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
+fn light_samples<
+    F: Float,
+    T: Transport<S: ChannelArray<N>>,
+    const N: usize,
+    const MOTION: bool,
+    const MEDIA: bool,
+>(
     ctx: &Ctx,
     st: &mut Paths<F, T, N>,
     sf: &Surface<F, N>,
@@ -411,6 +450,27 @@ fn light_samples<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize, con
     let shoot = ok & !contrib.is_zero();
     let (so, sd, t_max) = shadow_rays(sf.p, sf.nf, &ls);
     stats.shadow_rays += u64::from(shoot.count());
+    if MEDIA {
+        // The shadow ray may cross media: its transmittance, one lane at a time.
+        let mut tr = ScratchC::<N>::new();
+        let bits = shoot.bits();
+        for i in 0..F::WIDTH {
+            if bits >> i & 1 != 0 {
+                let lam = &st.lam[i];
+                let t: T::S = scene.transmittance_with::<MOTION, T::S>(
+                    &Ray::new(so.lane(i), sd.lane(i)),
+                    t_max.lane(i),
+                    st.time.lane(i),
+                    st.medium[i],
+                    #[inline(always)]
+                    |m, d| T::medium(ctx, m, lam).transmittance(d),
+                );
+                tr.set(i, t);
+            }
+        }
+        st.l = select_c(shoot, st.l + contrib * tr.load(), st.l);
+        return;
+    }
     let blocked = scene.occluded_packet::<F, MOTION>(so, sd, shoot, t_max, st.time);
     let lit = shoot.and_not(blocked);
     st.l = select_c(lit, st.l + contrib, st.l);
@@ -451,6 +511,7 @@ pub fn render_tile<
     T: Transport<S: ChannelArray<N>>,
     const N: usize,
     const MOTION: bool,
+    const MEDIA: bool,
 >(
     ctx: &Ctx,
     tile: &Tile,
@@ -478,6 +539,8 @@ pub fn render_tile<
         pixel: U::<F>::splat(0),
         sample: U::<F>::splat(0),
         alive: M::<F>::splat(false),
+        medium: [NO_MEDIUM; MAX_W],
+        segments: [0; MAX_W],
     };
     let scene = ctx.scene;
     let env = scene.environment;
@@ -490,9 +553,10 @@ pub fn render_tile<
         }
         stats.rays += started.count() as u64;
         stats.lane_slots += F::WIDTH as u64;
-        let sf = surfaces::<F, T, N, MOTION>(ctx, &st);
+        let hits = scene.intersect_packet::<F, MOTION>(st.o, st.d, st.alive, st.time);
+        let sf = surfaces::<F, T, N, MOTION, MEDIA>(ctx, &st, &hits);
         // Misses see the environment.
-        let miss = started.and_not(sf.hit);
+        let miss = started.and_not(sf.hit | sf.per_lane);
         if env != Vec3::ZERO && miss.any() {
             let first = st.depth.eq(U::<F>::splat(0)) | st.specular | M::<F>::splat(!ctx.nee);
             let w = F::select(
@@ -521,7 +585,10 @@ pub fn render_tile<
         let scatters = !sf.class.eq(U::<F>::splat(CLASS_NONE));
         st.alive = started & sf.hit & scatters & st.depth.lt(max_depth);
         if st.alive.any() {
-            scatter::<F, T, N, MOTION>(ctx, &mut st, &sf, stats);
+            scatter::<F, T, N, MOTION, MEDIA>(ctx, &mut st, &sf, stats);
+        }
+        if MEDIA && sf.per_lane.any() {
+            vertex_per_lane::<F, T, N, MOTION>(ctx, &mut st, &hits, sf.per_lane, stats);
         }
         // Finished paths go to the film.
         let ended = started.and_not(st.alive).bits();
@@ -537,7 +604,13 @@ pub fn render_tile<
 /// One scattering event in every live lane: light samples at diffuse lanes, then a BSDF
 /// sample per material class present, then Russian roulette.
 #[inline(always)]
-fn scatter<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
+fn scatter<
+    F: Float,
+    T: Transport<S: ChannelArray<N>>,
+    const N: usize,
+    const MOTION: bool,
+    const MEDIA: bool,
+>(
     ctx: &Ctx,
     st: &mut Paths<F, T, N>,
     sf: &Surface<F, N>,
@@ -560,7 +633,7 @@ fn scatter<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize, const MOT
     let mut scattered = M::<F>::splat(false);
     if dm.any() {
         if ctx.nee {
-            light_samples::<F, T, N, MOTION>(ctx, st, sf, dm, &frame, dim, stats);
+            light_samples::<F, T, N, MOTION, MEDIA>(ctx, st, sf, dm, &frame, dim, stats);
         }
         let (ux, uy) =
             ctx.sampler
@@ -624,6 +697,16 @@ fn scatter<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize, const MOT
         let down = offset_ray_origin_lanes(sf.p, -sf.nf);
         let o = V3::select(t, down, up);
         let d = V3::select(t, below(wi, sf.nf), reflect_above(wi, sf.nf));
+        if MEDIA {
+            let bits = t.bits();
+            let prims = &ctx.scene.prims;
+            for i in 0..F::WIDTH {
+                if bits >> i & 1 != 0 {
+                    st.medium[i] =
+                        prims.medium_after_crossing(sf.prim[i], sf.front.lane(i), st.medium[i]);
+                }
+            }
+        }
         st.o = V3::select(em, o, st.o);
         st.d = V3::select(em, d, st.d);
         scattered |= em;
@@ -657,7 +740,86 @@ fn russian_roulette<F: Float, T: Transport, const N: usize>(
     st.alive = st.alive.and_not(m & st.beta.is_zero());
 }
 
-/// Which effect variants the packet kernel runs: RGB or spectral transport without media.
-pub fn supports(media: bool) -> bool {
-    !media
+/// MEDIA: the vertex of each lane in `m` by the per-path integrator's step (free flight,
+/// scattering in the medium, boundaries, and the surface beyond), its shadow rays' light
+/// added through their media's transmittance as the wavefront's shadow stage does.
+#[inline(always)]
+fn vertex_per_lane<
+    F: Float,
+    T: Transport<S: ChannelArray<N>>,
+    const N: usize,
+    const MOTION: bool,
+>(
+    ctx: &Ctx,
+    st: &mut Paths<F, T, N>,
+    hits: &PacketHit<F>,
+    m: M<F>,
+    stats: &mut RenderStats,
+) {
+    let (mut o, mut d, mut prev_p) = (Scratch3::new(), Scratch3::new(), Scratch3::new());
+    let (mut beta, mut l) = (ScratchC::<N>::new(), ScratchC::<N>::new());
+    let (mut eta_scale, mut prev_pdf) = ([0.0f32; MAX_W], [0.0f32; MAX_W]);
+    let mut depth = [0u32; MAX_W];
+    let (mut specular, mut alive) = (0u32, 0u32);
+    let bits = m.bits();
+    for i in 0..F::WIDTH {
+        if bits >> i & 1 == 0 {
+            continue;
+        }
+        let mut s = PathState::<T> {
+            ray: Ray::new(st.o.lane(i), st.d.lane(i)),
+            beta: chan_lane(&st.beta, i),
+            l: chan_lane(&st.l, i),
+            lambda: st.lam[i],
+            eta_scale: st.eta_scale.lane(i),
+            depth: st.depth.lane(i),
+            specular: st.specular.lane(i),
+            prev_pdf: st.prev_pdf.lane(i),
+            prev_p: st.prev_p.lane(i),
+            time: st.time.lane(i),
+            pixel: st.pixel.lane(i),
+            sample: st.sample.lane(i),
+            alive: true,
+            medium: st.medium[i],
+            segments: st.segments[i],
+        };
+        let mut extra = None;
+        let shadow = shade::<T, MOTION, true>(ctx, &mut s, hits.lane(i), &mut extra);
+        for r in [shadow, extra].into_iter().flatten() {
+            stats.shadow_rays += 1;
+            let lam = &s.lambda;
+            let tr = ctx.scene.transmittance_with::<MOTION, T::S>(
+                &r.ray,
+                r.t_max,
+                s.time,
+                r.medium,
+                #[inline(always)]
+                |m, d| T::medium(ctx, m, lam).transmittance(d),
+            );
+            s.l += r.contrib * tr;
+        }
+        o.set(i, s.ray.o);
+        d.set(i, s.ray.d);
+        prev_p.set(i, s.prev_p);
+        beta.set(i, s.beta);
+        l.set(i, s.l);
+        eta_scale[i] = s.eta_scale;
+        prev_pdf[i] = s.prev_pdf;
+        depth[i] = s.depth;
+        specular |= (s.specular as u32) << i;
+        alive |= (s.alive as u32) << i;
+        st.lam[i] = s.lambda;
+        st.medium[i] = s.medium;
+        st.segments[i] = s.segments;
+    }
+    st.o = V3::select(m, o.v3(), st.o);
+    st.d = V3::select(m, d.v3(), st.d);
+    st.prev_p = V3::select(m, prev_p.v3(), st.prev_p);
+    st.beta = select_c(m, beta.load(), st.beta);
+    st.l = select_c(m, l.load(), st.l);
+    st.eta_scale = F::select(m, F::load(&eta_scale), st.eta_scale);
+    st.prev_pdf = F::select(m, F::load(&prev_pdf), st.prev_pdf);
+    st.depth = U::<F>::select(m, U::<F>::from_fn(|i| depth[i]), st.depth);
+    st.specular = st.specular.and_not(m) | (mask_from_bits::<F>(specular) & m);
+    st.alive = st.alive.and_not(m) | (mask_from_bits::<F>(alive) & m);
 }
