@@ -27,6 +27,7 @@ use super::{RenderStats, Tile};
 use crate::components::Material;
 use crate::geometry::{Ray, offset_ray_origin_lanes};
 use crate::simd::{Float, Mask, UInt, V3};
+use crate::spectrum::Channels;
 use crate::systems::light_lanes::LaneLightSample;
 use crate::systems::packet::PacketHit;
 use crate::systems::primitives::{NO_MEDIUM, emitted};
@@ -451,9 +452,18 @@ fn light_samples<
     let (so, sd, t_max) = shadow_rays(sf.p, sf.nf, &ls);
     stats.shadow_rays += u64::from(shoot.count());
     if MEDIA {
-        // The shadow ray may cross media: its transmittance, one lane at a time.
+        // These lanes start outside any medium, so a shadow ray that meets nothing has
+        // transmittance one (as `transmittance_with` finds); one that meets something may
+        // have crossed a medium's boundary, and takes `transmittance_with` per lane.
+        let blocked = scene.occluded_packet::<F, MOTION>(so, sd, shoot, t_max, st.time);
         let mut tr = ScratchC::<N>::new();
-        let bits = shoot.bits();
+        let clear = shoot.and_not(blocked).bits();
+        for i in 0..F::WIDTH {
+            if clear >> i & 1 != 0 {
+                tr.set(i, T::S::ONE);
+            }
+        }
+        let bits = blocked.bits();
         for i in 0..F::WIDTH {
             if bits >> i & 1 != 0 {
                 let lam = &st.lam[i];
