@@ -159,5 +159,148 @@ fn sample_generation(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, lane_math, sample_generation);
+fn cornell(size: u32, spp: u32) -> prism::systems::RenderScene {
+    let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.ron");
+    let o = vec![
+        ("render.width".to_string(), size.to_string()),
+        ("render.height".to_string(), size.to_string()),
+        ("render.spp".to_string(), spp.to_string()),
+    ];
+    let loaded = prism::scene_file::load(&path, &o).expect("cornell.ron loads");
+    prism::systems::prepare(&loaded, &prism::kdtree::KdParams::default())
+}
+
+/// The whole Cornell render (camera rays to film) at each lane form.
+fn render_widths(c: &mut Criterion) {
+    use prism::integrator::{Integrator, RenderOptions, render};
+    let scene = cornell(64, 4);
+    let mut g = c.benchmark_group("render_widths");
+    g.sample_size(10);
+    g.throughput(Throughput::Elements(64 * 64 * 4));
+    let mut all = forms();
+    all.push(("portable16".to_string(), Lanes::portable(16)));
+    for (form, lanes) in all {
+        let opts = RenderOptions {
+            sample_offset: 0,
+            spp: 4,
+            time_limit: None,
+            integrator: Integrator::Wavefront,
+            lanes,
+        };
+        g.bench_function(format!("cornell_64x64_4spp_{form}"), |b| {
+            b.iter(|| render(&scene, &opts, &|_| {}).stats.samples)
+        });
+    }
+    g.finish();
+}
+
+#[inline(always)]
+fn load3<F: Float>(a: &[[f32; 4096]; 3], i: usize) -> prism::simd::V3<F> {
+    prism::simd::V3::new(
+        F::load(&a[0][i..]),
+        F::load(&a[1][i..]),
+        F::load(&a[2][i..]),
+    )
+}
+
+/// Closest hits of SoA rays, a packet per `F::WIDTH` rays: the packet kd walk, or each lane's
+/// own single-ray walk.
+struct Closest<'a> {
+    scene: &'a prism::systems::RenderScene,
+    o: &'a [[f32; 4096]; 3],
+    d: &'a [[f32; 4096]; 3],
+    packet: bool,
+}
+
+impl LaneKernel for Closest<'_> {
+    type Output = u32;
+    #[inline(always)]
+    fn run<F: Float>(self) -> u32 {
+        use prism::simd::Mask;
+        let mut found = 0;
+        for i in (0..4096).step_by(F::WIDTH) {
+            let (o, d) = (load3::<F>(self.o, i), load3::<F>(self.d, i));
+            if self.packet {
+                let h = self.scene.intersect_packet::<F, false>(
+                    o,
+                    d,
+                    <F::Mask as Mask>::splat(true),
+                    F::zero(),
+                );
+                found += h.hit.count();
+            } else {
+                for l in 0..F::WIDTH {
+                    let ray = prism::geometry::Ray::new(o.lane(l), d.lane(l));
+                    found += u32::from(
+                        self.scene
+                            .intersect::<false>(&ray, f32::INFINITY, 0.0)
+                            .is_some(),
+                    );
+                }
+            }
+        }
+        found
+    }
+}
+
+/// The kd-tree walked as a packet against one ray at a time per lane, on coherent camera
+/// rays (four samples of each pixel, pixels along rows, as the packet kernel orders them) and
+/// on incoherent diffuse-like rays (random points and directions inside the box).
+fn kd_packet(c: &mut Criterion) {
+    use prism::sampling::{Sampler, SamplerKind, square_to_uniform_sphere};
+    let scene = cornell(32, 4);
+    let ctx = prism::integrator::Ctx::new(&scene, false);
+    let mut cam = ([[0.0f32; 4096]; 3], [[0.0f32; 4096]; 3]);
+    for k in 0..4096u32 {
+        let (p, idx) = (k / 4, k % 4);
+        let r = prism::integrator::path::camera_rays::<f32, false>(&ctx, p % 32, p / 32, idx);
+        for (a, v) in [(&mut cam.0, r.o), (&mut cam.1, r.d)] {
+            (a[0][k as usize], a[1][k as usize], a[2][k as usize]) = (v.x, v.y, v.z);
+        }
+    }
+    let s = Sampler::new(SamplerKind::Independent, 3);
+    let mut diffuse = ([[0.0f32; 4096]; 3], [[0.0f32; 4096]; 3]);
+    for k in 0..4096u32 {
+        let o = glam::Vec3::new(278.0, 273.0, 280.0)
+            + square_to_uniform_sphere(s.get_2d(k, 0, 0)) * 200.0;
+        let d = square_to_uniform_sphere(s.get_2d(k, 0, 2));
+        for (a, v) in [(&mut diffuse.0, o), (&mut diffuse.1, d)] {
+            (a[0][k as usize], a[1][k as usize], a[2][k as usize]) = (v.x, v.y, v.z);
+        }
+    }
+    let mut g = c.benchmark_group("kd_packet");
+    g.throughput(Throughput::Elements(4096));
+    for (rays, (o, d)) in [("camera", &cam), ("diffuse", &diffuse)] {
+        for (form, lanes) in forms() {
+            for packet in [true, false] {
+                if lanes.width() == 1 && !packet {
+                    continue;
+                }
+                let walk = if packet { "packet" } else { "per_lane" };
+                g.bench_function(format!("{rays}_{walk}_{form}"), |b| {
+                    b.iter(|| {
+                        simd::dispatch(
+                            lanes,
+                            Closest {
+                                scene: &scene,
+                                o,
+                                d,
+                                packet,
+                            },
+                        )
+                    })
+                });
+            }
+        }
+    }
+    g.finish();
+}
+
+criterion_group!(
+    benches,
+    lane_math,
+    sample_generation,
+    render_widths,
+    kd_packet
+);
 criterion_main!(benches);
