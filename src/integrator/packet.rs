@@ -2,21 +2,23 @@
 //! lane-SoA registers, and refills a lane with the tile's next sample as soon as its path ends.
 //!
 //! ```text
-//! refill → intersect + surface (per lane) → emission → light samples → BSDF → roulette → film
-//!    ↑_____________________________________________________________________________|
+//! refill → intersect (packet kd walk) → surfaces (per lane) → emission → light samples +
+//!    ↑      shadow packet → BSDF per material class → roulette → film
+//!    |____________________________________________________________|
 //! ```
 //!
-//! Camera rays, the sampler, the BSDFs, MIS, Russian roulette and the throughput arithmetic
-//! run over lanes, written once over [`Float`] with the scalar integrator's operations in the
-//! same order, so a lane's path is the reference path up to rounding (and bit for bit where
-//! both use the same lane functions). What still runs one lane at a time inside the packet:
-//! the kd-tree walk and primitive tests, surface reconstruction with its texture lookups,
-//! light-sample geometry and the shadow rays' any-hit walk.
+//! Camera rays, the sampler, the kd walk and the analytic shapes' tests, rectangle light
+//! samples, the BSDFs, MIS, Russian roulette and the throughput arithmetic run over lanes,
+//! written once over [`Float`] with the scalar integrator's operations in the same order, so a
+//! lane's path is the reference path up to rounding (and bit for bit where both use the same
+//! lane functions). Still one lane at a time inside the packet: mesh and revolution tests,
+//! surface reconstruction with its texture lookups, other lights' samples.
 //!
-//! Covers RGB and spectral transport without media, with or without MOTION, LENS, TEXTURES
-//! and NORMAL_MAPS; media run the per-path integrator (`supports`). Spectral paths carry four
-//! channels (`Chan<F, 4>`, one per hero wavelength) and keep their wavelengths per lane, where
-//! the per-lane stages evaluate the scene's spectra with the scalar transport's functions.
+//! Every effect variant runs here. Spectral paths carry four channels (`Chan<F, 4>`, one per
+//! hero wavelength) and keep their wavelengths per lane, where the per-lane stages evaluate
+//! the scene's spectra with the scalar transport's functions. With MEDIA, a lane inside a
+//! medium or at a medium's boundary takes the per-path vertex step ([`shade`]) for that
+//! vertex; the others stay in lanes.
 
 use super::bsdf::{Chan, Dielectric, Diffuse, Frame, LaneChannels, Mirror, Mode};
 use super::path::{
