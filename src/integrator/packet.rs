@@ -280,8 +280,8 @@ impl<F: Float, const N: usize> C<F, N> {
     }
 }
 
-/// Closest hits and what lies there, one lane at a time: the kd walk, the surface, its
-/// textures and material, and for emitters their radiance with its MIS weight.
+/// What lies at each lane's closest hit, one lane at a time: the surface, its textures and
+/// material, and for emitters their radiance with its MIS weight.
 #[inline(always)]
 fn surfaces<
     F: Float,
