@@ -683,9 +683,16 @@ fn scatter<
                 else {
                     continue;
                 };
-                let mut b: T::S = chan_lane(&st.beta, i);
+                // RGB transport's `eta` leaves the throughput alone.
+                let mut b: T::S = if T::SPECTRAL {
+                    chan_lane(&st.beta, i)
+                } else {
+                    T::S::ONE
+                };
                 *n = T::eta(&model, &mut st.lam[i], &mut b);
-                beta.set(i, b);
+                if T::SPECTRAL {
+                    beta.set(i, b);
+                }
             }
         }
         if T::SPECTRAL {
