@@ -63,6 +63,7 @@ enum Fun {
     Cos,
     Exp,
     Ln,
+    Ln1p,
     Atan,
     Asin,
     Acos,
@@ -93,6 +94,7 @@ impl LaneKernel for Eval<'_> {
                 Fun::Cos => math::cos(x),
                 Fun::Exp => math::exp(x),
                 Fun::Ln => math::ln(x),
+                Fun::Ln1p => math::ln_1p(x),
                 Fun::Atan => math::atan(x),
                 Fun::Asin => math::asin(x),
                 Fun::Acos => math::acos(x),
@@ -125,6 +127,7 @@ fn reference(fun: Fun, x: f32, y: f32) -> f64 {
         Fun::Cos => x.cos(),
         Fun::Exp => x.exp(),
         Fun::Ln => x.ln(),
+        Fun::Ln1p => x.ln_1p(),
         Fun::Atan => x.atan(),
         Fun::Asin => x.asin(),
         Fun::Acos => x.acos(),
@@ -293,6 +296,14 @@ fn ln_within_two_ulp() {
     let a = arguments(3, (1e-3, 10.0), (0.0, 1e30), |_| true);
     let b = vec![0.0; a.len()];
     assert_within(Fun::Ln, check(Fun::Ln, &a, &b, |_, _| true), 2.0);
+}
+
+#[test]
+fn ln_1p_within_four_ulp() {
+    // Free-flight distances take ln(1 − u) for u ∈ [0, 1): small |x| is where it matters.
+    let a = arguments(9, (-1.0, 1e-2), (-1.0, 1e30), |x| x >= -1.0 || x.is_nan());
+    let b = vec![0.0; a.len()];
+    assert_within(Fun::Ln1p, check(Fun::Ln1p, &a, &b, |_, _| true), 4.0);
 }
 
 #[test]

@@ -609,11 +609,11 @@ fn russian_roulette<T: Transport>(ctx: &Ctx, s: &mut PathState<T>, dim: u32) {
 
 /// Where free-flight sampling put a scattering event: the segment's ray, the distance, the
 /// segment's end and the density of that distance (for MIS with equiangular sampling).
-struct Segment {
-    ray: Ray,
-    t: f32,
-    t_hit: f32,
-    p_ff: f32,
+pub(crate) struct Segment {
+    pub ray: Ray,
+    pub t: f32,
+    pub t_hit: f32,
+    pub p_ff: f32,
 }
 
 /// Equiangular sampling (Kulla & Fajardo 2012): a scattering distance on the segment drawn
@@ -638,8 +638,10 @@ struct Segment {
 /// non-zero (where (b) is the only one, `w_b = 1`), so the sum is unbiased. Every factor is
 /// known at each technique's sample, and (b)'s weight does not involve (c), so emitters hit
 /// by chance need nothing about the segment they were reached from.
-#[inline]
-fn equiangular_nee<T: Transport, const MOTION: bool>(
+// Always inlined: out of the lane kernels' `target_feature` entry points, the lane math it
+// runs at width 1 would call `fmaf` for every fused multiply-add.
+#[inline(always)]
+pub(crate) fn equiangular_nee<T: Transport, const MOTION: bool>(
     ctx: &Ctx,
     s: &PathState<T>,
     med: &T::Med,
@@ -722,6 +724,52 @@ fn equiangular_nee<T: Transport, const MOTION: bool>(
     }
 }
 
+/// The MIS weight of a light sample (`point`, `delta`, `source`, solid-angle `pdf`) taken
+/// from the scattering point `p` of `seg`, whose phase function gives `ph` towards it.
+#[inline]
+#[allow(clippy::too_many_arguments)]
+pub(crate) fn medium_light_weight<const MOTION: bool>(
+    ctx: &Ctx,
+    point: Option<(Vec3, Vec3)>,
+    delta: bool,
+    source: LightSource,
+    pdf: f32,
+    ph: f32,
+    p: Vec3,
+    seg: &Segment,
+    time: f32,
+) -> f32 {
+    match (point, source) {
+        // The equiangular technique also produces this point light's scattering: weight by
+        // the two distance densities.
+        (Some((q, _)), _) if delta && ctx.equiangular => {
+            Equiangular::new(seg.ray.o, seg.ray.d, 0.0, seg.t_hit, q)
+                .map_or(1.0, |eq| seg.p_ff / (seg.p_ff + eq.pdf(seg.t)))
+        }
+        _ if delta => 1.0,
+        // An area light: (a) of `equiangular_nee`'s three techniques.
+        (Some((q, nq)), LightSource::Area { prim, .. }) if ctx.equiangular => {
+            let d = q - p;
+            let d2 = d.length_squared();
+            let g = nq.dot(d).abs() / (d2 * d2.sqrt());
+            let p_a = seg.p_ff * pdf * g;
+            let p_c = Equiangular::new(seg.ray.o, seg.ray.d, 0.0, seg.t_hit, q)
+                .map_or(0.0, |eq| eq.pdf(seg.t))
+                * ctx.scene.lights.equiangular_area_density::<MOTION>(
+                    &ctx.scene.prims,
+                    prim,
+                    nq,
+                    &seg.ray,
+                    seg.t_hit,
+                    time,
+                );
+            let share = p_a / (p_a + p_c);
+            power_heuristic(pdf, ph) * if share.is_finite() { share } else { 1.0 }
+        }
+        _ => power_heuristic(pdf, ph),
+    }
+}
+
 /// A shadow ray from a point in a medium (on no surface: no offset at this end) to the point
 /// `q` (normal `nq`) on an emitter, stopping just off its surface on the side facing `p`.
 #[inline]
@@ -761,35 +809,9 @@ fn scatter_in_medium<T: Transport, const MOTION: bool>(
                 .sample::<MOTION>(prims, p, u_sel, u_l, s.time, ctx.textures)
         {
             let ph = med.phase(wo, ls.wi);
-            let w = match (ls.point, ls.source) {
-                // The equiangular technique also produces this point light's scattering:
-                // weight by the two distance densities.
-                (Some((q, _)), _) if ls.delta && ctx.equiangular => {
-                    Equiangular::new(seg.ray.o, seg.ray.d, 0.0, seg.t_hit, q)
-                        .map_or(1.0, |eq| seg.p_ff / (seg.p_ff + eq.pdf(seg.t)))
-                }
-                _ if ls.delta => 1.0,
-                // An area light: (a) of `equiangular_nee`'s three techniques.
-                (Some((q, nq)), LightSource::Area { prim, .. }) if ctx.equiangular => {
-                    let d = q - p;
-                    let d2 = d.length_squared();
-                    let g = nq.dot(d).abs() / (d2 * d2.sqrt());
-                    let p_a = seg.p_ff * ls.pdf * g;
-                    let p_c = Equiangular::new(seg.ray.o, seg.ray.d, 0.0, seg.t_hit, q)
-                        .map_or(0.0, |eq| eq.pdf(seg.t))
-                        * ctx.scene.lights.equiangular_area_density::<MOTION>(
-                            &ctx.scene.prims,
-                            prim,
-                            nq,
-                            &seg.ray,
-                            seg.t_hit,
-                            s.time,
-                        );
-                    let share = p_a / (p_a + p_c);
-                    power_heuristic(ls.pdf, ph) * if share.is_finite() { share } else { 1.0 }
-                }
-                _ => power_heuristic(ls.pdf, ph),
-            };
+            let w = medium_light_weight::<MOTION>(
+                ctx, ls.point, ls.delta, ls.source, ls.pdf, ph, p, &seg, s.time,
+            );
             let contrib = s.beta * T::light_radiance(ctx, &ls, &s.lambda) * (ph * w / ls.pdf);
             if contrib != T::S::ZERO && contrib.is_finite() {
                 // A point in a medium lies on no surface: no offset at this end.

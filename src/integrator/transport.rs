@@ -9,7 +9,7 @@
 //! converting the accumulated XYZ).
 
 use super::path::Ctx;
-use crate::medium::{DistanceSample, HomogeneousMedium};
+use crate::medium::{DistanceSample, HomogeneousMedium, lanes};
 use crate::spectrum::{
     Channels, EmitterSpectrum, IorModel, RgbIlluminant, RgbSigmoid, RgbUnbounded, SampledSpectrum,
     Wavelengths,
@@ -23,8 +23,17 @@ use glam::{Vec2, Vec3};
 pub const LAMBDA_D: f32 = 587.56;
 
 /// A homogeneous medium with coefficients in the transport's channels.
+///
+/// The estimators are [`crate::medium::lanes`]' at width 1, the functions the packet kernel
+/// runs over lanes, so both integrators take the same decisions from the same numbers. Their
+/// methods are always inlined: out of the lane kernels' `target_feature` entry points the
+/// lane math would call `fmaf` and `rintf` for every fused multiply-add and rounding.
 pub trait MediumOps<S>: Copy {
     fn sigma_s(&self) -> S;
+    /// Extinction σt = σa + σs.
+    fn sigma_t(&self) -> S;
+    /// Henyey–Greenstein asymmetry.
+    fn g(&self) -> f32;
     fn transmittance(&self, d: f32) -> S;
     fn sample_distance(&self, t_max: f32, u_c: f32, u: f32, probs: S) -> DistanceSample<S>;
     fn distance_pdf(&self, t: f32, probs: S) -> f32;
@@ -32,30 +41,71 @@ pub trait MediumOps<S>: Copy {
     fn sample_phase(&self, wo: Vec3, u: Vec2) -> (Vec3, f32);
 }
 
+/// [`MediumOps`] for any channel array, through the lane estimators at width 1.
+#[inline(always)]
+fn free_flight<const N: usize>(
+    sigma_s: [f32; N],
+    sigma_t: [f32; N],
+    t_max: f32,
+    u_c: f32,
+    u: f32,
+    probs: [f32; N],
+) -> DistanceSample<[f32; N]> {
+    let f = lanes::sample_free_flight::<f32, N>(&sigma_s, &sigma_t, t_max, u_c, u, &probs);
+    if f.scatter {
+        DistanceSample::Scatter {
+            t: f.t,
+            weight: f.weight,
+        }
+    } else {
+        DistanceSample::Pass { weight: f.weight }
+    }
+}
+
 impl MediumOps<Vec3> for HomogeneousMedium {
-    #[inline]
+    #[inline(always)]
     fn sigma_s(&self) -> Vec3 {
         self.sigma_s
     }
-    #[inline]
+    #[inline(always)]
+    fn sigma_t(&self) -> Vec3 {
+        HomogeneousMedium::sigma_t(self)
+    }
+    #[inline(always)]
+    fn g(&self) -> f32 {
+        self.g
+    }
+    #[inline(always)]
     fn transmittance(&self, d: f32) -> Vec3 {
-        HomogeneousMedium::transmittance(self, d)
+        Vec3::from_array(lanes::transmittance::<f32, 3>(
+            &self.sigma_t().to_array(),
+            d,
+        ))
     }
-    #[inline]
+    #[inline(always)]
     fn sample_distance(&self, t_max: f32, u_c: f32, u: f32, probs: Vec3) -> DistanceSample {
-        HomogeneousMedium::sample_distance(self, t_max, u_c, u, probs)
+        free_flight(
+            self.sigma_s.to_array(),
+            self.sigma_t().to_array(),
+            t_max,
+            u_c,
+            u,
+            probs.to_array(),
+        )
+        .map(Vec3::from_array)
     }
-    #[inline]
+    #[inline(always)]
     fn distance_pdf(&self, t: f32, probs: Vec3) -> f32 {
-        HomogeneousMedium::distance_pdf(self, t, probs)
+        lanes::free_flight_pdf::<f32, 3>(&self.sigma_t().to_array(), t, &probs.to_array())
     }
-    #[inline]
+    #[inline(always)]
     fn phase(&self, wo: Vec3, wi: Vec3) -> f32 {
-        HomogeneousMedium::phase(self, wo, wi)
+        lanes::hg_phase_dirs::<f32>(wo.into(), wi.into(), self.g)
     }
-    #[inline]
+    #[inline(always)]
     fn sample_phase(&self, wo: Vec3, u: Vec2) -> (Vec3, f32) {
-        HomogeneousMedium::sample_phase(self, wo, u)
+        let (wi, pdf) = lanes::sample_hg::<f32>(wo.into(), self.g, u.x, u.y);
+        (wi.into(), pdf)
     }
 }
 
@@ -68,15 +118,23 @@ pub struct SpectralMedium {
 }
 
 impl MediumOps<SampledSpectrum> for SpectralMedium {
-    #[inline]
+    #[inline(always)]
     fn sigma_s(&self) -> SampledSpectrum {
         self.sigma_s
     }
-    #[inline]
-    fn transmittance(&self, d: f32) -> SampledSpectrum {
-        SampledSpectrum(crate::medium::transmittance_channels(self.sigma_t.0, d))
+    #[inline(always)]
+    fn sigma_t(&self) -> SampledSpectrum {
+        self.sigma_t
     }
-    #[inline]
+    #[inline(always)]
+    fn g(&self) -> f32 {
+        self.g
+    }
+    #[inline(always)]
+    fn transmittance(&self, d: f32) -> SampledSpectrum {
+        SampledSpectrum(lanes::transmittance::<f32, 4>(&self.sigma_t.0, d))
+    }
+    #[inline(always)]
     fn sample_distance(
         &self,
         t_max: f32,
@@ -84,20 +142,20 @@ impl MediumOps<SampledSpectrum> for SpectralMedium {
         u: f32,
         probs: SampledSpectrum,
     ) -> DistanceSample<SampledSpectrum> {
-        crate::medium::sample_free_flight(self.sigma_s.0, self.sigma_t.0, t_max, u_c, u, probs.0)
-            .map(SampledSpectrum)
+        free_flight(self.sigma_s.0, self.sigma_t.0, t_max, u_c, u, probs.0).map(SampledSpectrum)
     }
-    #[inline]
+    #[inline(always)]
     fn distance_pdf(&self, t: f32, probs: SampledSpectrum) -> f32 {
-        crate::medium::free_flight_pdf(self.sigma_t.0, t, probs.0)
+        lanes::free_flight_pdf::<f32, 4>(&self.sigma_t.0, t, &probs.0)
     }
-    #[inline]
+    #[inline(always)]
     fn phase(&self, wo: Vec3, wi: Vec3) -> f32 {
-        crate::medium::hg_phase_dirs(wo, wi, self.g)
+        lanes::hg_phase_dirs::<f32>(wo.into(), wi.into(), self.g)
     }
-    #[inline]
+    #[inline(always)]
     fn sample_phase(&self, wo: Vec3, u: Vec2) -> (Vec3, f32) {
-        crate::medium::sample_hg(wo, self.g, u)
+        let (wi, pdf) = lanes::sample_hg::<f32>(wo.into(), self.g, u.x, u.y);
+        (wi.into(), pdf)
     }
 }
 

@@ -47,6 +47,7 @@
 //!   `|g|` to [`HG_G_MAX`] so `b = 1` stays finite.
 
 mod distance;
+pub mod lanes;
 mod phase;
 
 pub use distance::*;

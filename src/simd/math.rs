@@ -17,6 +17,7 @@
 //! | `sin`, `cos`, `sin_cos` | \|x\| > 2²⁰ | no accuracy bound; the result lies in [−1, 1]; ±∞ gives NaN |
 //! | `exp` | all | 2 ulp; ≥ 88.7228… gives +∞, below −103.98 gives 0 |
 //! | `ln` | all | 2 ulp; 0 gives −∞, negative gives NaN, +∞ gives +∞ |
+//! | `ln_1p` | all | 4 ulp; −1 gives −∞, below −1 gives NaN, +∞ gives +∞ |
 //! | `atan` | all | 2.5 ulp |
 //! | `atan2` | all | 3 ulp; C99 special cases (±0, ±∞) |
 //! | `asin`, `acos` | [−1, 1] | 3 ulp; outside gives NaN |
@@ -183,6 +184,19 @@ pub fn ln<F: Float>(x: F) -> F {
     let y = F::select(x.eq(F::splat(f32::INFINITY)), x, y);
     // Negative arguments and NaN.
     F::select(x.lt(F::zero()) | x.is_nan(), F::splat(f32::NAN), y)
+}
+
+/// ln(1 + x), accurate for small |x| where `ln(1 + x)` loses its digits to the rounding of
+/// 1 + x: with w = 1 + x rounded, ln(w) · x / (w − 1) cancels that rounding (Goldberg 1991,
+/// theorem 4).
+#[inline(always)]
+pub fn ln_1p<F: Float>(x: F) -> F {
+    let w = F::one() + x;
+    let y = ln(w) * (x / (w - F::one()));
+    // w = 1: x is below half an ulp of 1 and ln(1 + x) = x to f32 precision (keeps ±0);
+    // x = +∞ would give ∞/∞.
+    let y = F::select(w.eq(F::one()), x, y);
+    F::select(x.eq(F::splat(f32::INFINITY)), x, y)
 }
 
 /// xʸ for x ≥ 0, as e^(y ln x).

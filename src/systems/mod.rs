@@ -164,8 +164,9 @@ impl RenderScene {
     }
 
     /// [`Self::transmittance`] in any channels: `medium_tr(m, d)` is medium `m`'s
-    /// transmittance over distance `d`.
-    #[inline]
+    /// transmittance over distance `d`. Always inlined, for the same reason as the medium's
+    /// estimators (`integrator::transport::MediumOps`).
+    #[inline(always)]
     pub fn transmittance_with<const MOTION: bool, S: crate::spectrum::Channels>(
         &self,
         ray: &Ray,
