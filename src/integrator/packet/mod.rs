@@ -16,15 +16,15 @@
 //!
 //! Every effect variant runs here. Spectral paths carry four channels (`Chan<F, 4>`, one per
 //! hero wavelength) and keep their wavelengths per lane, where the per-lane stages evaluate
-//! the scene's spectra with the scalar transport's functions. With MEDIA, a lane inside a
-//! medium or at a medium's boundary takes the per-path vertex step ([`shade`]) for that
-//! vertex; the others stay in lanes.
+//! the scene's spectra with the scalar transport's functions. With MEDIA, lanes inside a
+//! medium sample their free flight and scatter there over lanes ([`medium`]); lanes that
+//! meet a medium's boundary cross it over lanes.
+
+mod medium;
 
 use super::bsdf::{Chan, Dielectric, Diffuse, Frame, LaneChannels, Mirror, Mode};
-use super::path::{
-    self, Ctx, DIM_BOUNCE, DIMS_PER_BOUNCE, PathState, camera_rays, shade, surface_material,
-};
-use super::transport::{ChannelArray, MediumOps, Transport};
+use super::path::{self, Ctx, DIM_BOUNCE, DIMS_PER_BOUNCE, camera_rays, surface_material};
+use super::transport::{ChannelArray, Transport};
 use super::{RenderStats, Tile};
 use crate::components::Material;
 use crate::geometry::{Ray, offset_ray_origin_lanes};
@@ -49,6 +49,8 @@ const CLASS_NONE: u32 = 0;
 const CLASS_DIFFUSE: u32 = 1;
 const CLASS_MIRROR: u32 = 2;
 const CLASS_DIELECTRIC: u32 = 3;
+/// MEDIA: a medium's boundary, crossed without scattering.
+const CLASS_BOUNDARY: u32 = 4;
 
 /// The state of `F::WIDTH` paths, one per lane. Dead lanes hold stale values until refilled.
 struct Paths<F: Float, T: Transport, const N: usize> {
@@ -67,8 +69,7 @@ struct Paths<F: Float, T: Transport, const N: usize> {
     pixel: U<F>,
     sample: U<F>,
     alive: M<F>,
-    /// MEDIA: each lane's medium and medium segments so far (read only by the per-lane
-    /// vertex step).
+    /// MEDIA: each lane's medium and the medium segments its path has sampled so far.
     medium: [u32; MAX_W],
     segments: [u32; MAX_W],
 }
@@ -88,9 +89,6 @@ struct Surface<F: Float, const N: usize> {
     /// medium behind a dielectric).
     mat: [u32; MAX_W],
     prim: [u32; MAX_W],
-    /// MEDIA: lanes whose vertex runs per lane (in a medium, or at a medium's boundary); the
-    /// other fields do not describe them.
-    per_lane: M<F>,
     /// Lanes that hit an emitter with non-zero radiance, the radiance and its MIS weight.
     emits: M<F>,
     le: C<F, N>,
@@ -293,6 +291,7 @@ fn surfaces<
     ctx: &Ctx,
     st: &Paths<F, T, N>,
     hits: &PacketHit<F>,
+    at: M<F>,
 ) -> Surface<F, N> {
     let scene = ctx.scene;
     let prims = &scene.prims;
@@ -303,13 +302,8 @@ fn surfaces<
     let mut prim = [0u32; MAX_W];
     let mut le_w = [0.0f32; MAX_W];
     let (mut hit_bits, mut front_bits, mut emit_bits) = (0u32, 0u32, 0u32);
-    let mut per_lane = 0u32;
-    let (alive, found) = (st.alive.bits(), hits.hit.bits());
+    let found = (hits.hit & at).bits();
     for i in 0..F::WIDTH {
-        if MEDIA && alive >> i & 1 != 0 && st.medium[i] != NO_MEDIUM {
-            per_lane |= 1 << i;
-            continue;
-        }
         if found >> i & 1 == 0 {
             continue;
         }
@@ -319,10 +313,6 @@ fn surfaces<
             continue;
         };
         let mat = prims.material[hit.prim as usize];
-        if MEDIA && let Material::Boundary = prims.materials[mat as usize] {
-            per_lane |= 1 << i;
-            continue;
-        }
         hit_bits |= 1 << i;
         mats[i] = mat;
         prim[i] = hit.prim;
@@ -366,7 +356,8 @@ fn surfaces<
                     };
                 }
             }
-            Material::Boundary => {}
+            // Only MEDIA scenes have boundaries.
+            Material::Boundary => class[i] = if MEDIA { CLASS_BOUNDARY } else { CLASS_NONE },
         }
     }
     Surface {
@@ -379,7 +370,6 @@ fn surfaces<
         color: color.load(),
         mat: mats,
         prim,
-        per_lane: mask_from_bits::<F>(per_lane),
         emits: mask_from_bits::<F>(emit_bits),
         le: le.load(),
         le_w: F::load(&le_w),
@@ -434,9 +424,31 @@ fn light_samples<
     let f = bsdf.eval(wo_l, wi_l) * cos;
     let pdf = ls.pdf;
     let w = F::select(ls.delta, F::one(), power_heuristic(pdf, bsdf_pdf));
-    let rad = if T::SPECTRAL {
+    let rad = lane_radiance(ctx, st, &ls, ok);
+    let contrib = st.beta * f * rad * (w / pdf);
+    let shoot = ok & !contrib.is_zero();
+    let (so, sd, t_max) = shadow_rays(sf.p, sf.nf, &ls);
+    if MEDIA {
+        medium::shadows::<F, T, N, MOTION>(ctx, st, so, sd, t_max, contrib, shoot, stats);
+        return;
+    }
+    stats.shadow_rays += u64::from(shoot.count());
+    let blocked = scene.occluded_packet::<F, MOTION>(so, sd, shoot, t_max, st.time);
+    let lit = shoot.and_not(blocked);
+    st.l = select_c(lit, st.l + contrib, st.l);
+}
+
+/// Each lane's light-sample radiance in the transport's channels, for the lanes in `m`.
+#[inline(always)]
+fn lane_radiance<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize>(
+    ctx: &Ctx,
+    st: &Paths<F, T, N>,
+    ls: &LaneLightSample<F>,
+    m: M<F>,
+) -> C<F, N> {
+    if T::SPECTRAL {
         let mut rad = ScratchC::<N>::new();
-        let bits = ok.bits();
+        let bits = m.bits();
         for i in 0..F::WIDTH {
             if bits >> i & 1 != 0 {
                 let rgb = ls.radiance.lane(i);
@@ -448,44 +460,7 @@ fn light_samples<
         // RGB: N = 3.
         let r = [ls.radiance.x, ls.radiance.y, ls.radiance.z];
         Chan(std::array::from_fn(|k| r[k]))
-    };
-    let contrib = st.beta * f * rad * (w / pdf);
-    let shoot = ok & !contrib.is_zero();
-    let (so, sd, t_max) = shadow_rays(sf.p, sf.nf, &ls);
-    stats.shadow_rays += u64::from(shoot.count());
-    if MEDIA {
-        // These lanes start outside any medium, so a shadow ray that meets nothing has
-        // transmittance one (as `transmittance_with` finds); one that meets something may
-        // have crossed a medium's boundary, and takes `transmittance_with` per lane.
-        let blocked = scene.occluded_packet::<F, MOTION>(so, sd, shoot, t_max, st.time);
-        let mut tr = ScratchC::<N>::new();
-        let clear = shoot.and_not(blocked).bits();
-        for i in 0..F::WIDTH {
-            if clear >> i & 1 != 0 {
-                tr.set(i, T::S::ONE);
-            }
-        }
-        let bits = blocked.bits();
-        for i in 0..F::WIDTH {
-            if bits >> i & 1 != 0 {
-                let lam = &st.lam[i];
-                let t: T::S = scene.transmittance_with::<MOTION, T::S>(
-                    &Ray::new(so.lane(i), sd.lane(i)),
-                    t_max.lane(i),
-                    st.time.lane(i),
-                    st.medium[i],
-                    #[inline(always)]
-                    |m, d| T::medium(ctx, m, lam).transmittance(d),
-                );
-                tr.set(i, t);
-            }
-        }
-        st.l = select_c(shoot, st.l + contrib * tr.load(), st.l);
-        return;
     }
-    let blocked = scene.occluded_packet::<F, MOTION>(so, sd, shoot, t_max, st.time);
-    let lit = shoot.and_not(blocked);
-    st.l = select_c(lit, st.l + contrib, st.l);
 }
 
 /// `path::shadow_ray_from_surface` over lanes: towards the sampled point of an area light
@@ -566,9 +541,17 @@ pub fn render_tile<
         stats.rays += started.count() as u64;
         stats.lane_slots += F::WIDTH as u64;
         let hits = scene.intersect_packet::<F, MOTION>(st.o, st.d, st.alive, st.time);
-        let sf = surfaces::<F, T, N, MOTION, MEDIA>(ctx, &st, &hits);
+        // MEDIA: lanes in a medium first sample their flight; those that scatter there are
+        // done with this vertex, the rest reach their hit.
+        let in_medium = if MEDIA {
+            medium::medium_stage::<F, T, N, MOTION>(ctx, &mut st, &hits, started, stats)
+        } else {
+            M::<F>::splat(false)
+        };
+        let at = st.alive.and_not(in_medium);
+        let sf = surfaces::<F, T, N, MOTION, MEDIA>(ctx, &st, &hits, at);
         // Misses see the environment.
-        let miss = started.and_not(sf.hit | sf.per_lane);
+        let miss = at.and_not(sf.hit);
         if env != Vec3::ZERO && miss.any() {
             let first = st.depth.eq(U::<F>::splat(0)) | st.specular | M::<F>::splat(!ctx.nee);
             let w = F::select(
@@ -594,13 +577,24 @@ pub fn render_tile<
         }
         // Emitters add their radiance and absorb the rest.
         st.l = select_c(sf.emits, st.l + st.beta * sf.le * sf.le_w, st.l);
-        let scatters = !sf.class.eq(U::<F>::splat(CLASS_NONE));
-        st.alive = started & sf.hit & scatters & st.depth.lt(max_depth);
-        if st.alive.any() {
-            scatter::<F, T, N, MOTION, MEDIA>(ctx, &mut st, &sf, stats);
+        let boundary = sf.hit & sf.class.eq(U::<F>::splat(CLASS_BOUNDARY));
+        let scatters = !sf.class.eq(U::<F>::splat(CLASS_NONE)) & !boundary;
+        let surface = sf.hit & scatters & st.depth.lt(max_depth);
+        st.alive = (st.alive & in_medium) | surface | boundary;
+        if surface.any() {
+            scatter::<F, T, N, MOTION, MEDIA>(ctx, &mut st, &sf, surface, stats);
         }
-        if MEDIA && sf.per_lane.any() {
-            vertex_per_lane::<F, T, N, MOTION>(ctx, &mut st, &hits, sf.per_lane, stats);
+        if MEDIA && boundary.any() {
+            // Carry on in the same direction, in the medium beyond.
+            st.o = V3::select(boundary, offset_ray_origin_lanes(sf.p, -sf.nf), st.o);
+            let bits = boundary.bits();
+            let prims = &scene.prims;
+            for i in 0..F::WIDTH {
+                if bits >> i & 1 != 0 {
+                    st.medium[i] =
+                        prims.medium_after_crossing(sf.prim[i], sf.front.lane(i), st.medium[i]);
+                }
+            }
         }
         // Finished paths go to the film.
         let ended = started.and_not(st.alive).bits();
@@ -613,7 +607,7 @@ pub fn render_tile<
     }
 }
 
-/// One scattering event in every live lane: light samples at diffuse lanes, then a BSDF
+/// One scattering event in every lane of `live`: light samples at diffuse lanes, then a BSDF
 /// sample per material class present, then Russian roulette.
 #[inline(always)]
 fn scatter<
@@ -626,9 +620,9 @@ fn scatter<
     ctx: &Ctx,
     st: &mut Paths<F, T, N>,
     sf: &Surface<F, N>,
+    live: M<F>,
     stats: &mut RenderStats,
 ) {
-    let live = st.alive;
     let dim = U::<F>::splat(DIM_BOUNCE)
         .wrapping_add(st.depth.wrapping_mul(U::<F>::splat(DIMS_PER_BOUNCE)));
     st.depth = U::<F>::select(live, st.depth.wrapping_add(U::<F>::splat(1)), st.depth);
@@ -757,88 +751,4 @@ fn russian_roulette<F: Float, T: Transport, const N: usize>(
         }
     }
     st.alive = st.alive.and_not(m & st.beta.is_zero());
-}
-
-/// MEDIA: the vertex of each lane in `m` by the per-path integrator's step (free flight,
-/// scattering in the medium, boundaries, and the surface beyond), its shadow rays' light
-/// added through their media's transmittance as the wavefront's shadow stage does.
-#[inline(always)]
-fn vertex_per_lane<
-    F: Float,
-    T: Transport<S: ChannelArray<N>>,
-    const N: usize,
-    const MOTION: bool,
->(
-    ctx: &Ctx,
-    st: &mut Paths<F, T, N>,
-    hits: &PacketHit<F>,
-    m: M<F>,
-    stats: &mut RenderStats,
-) {
-    let (mut o, mut d, mut prev_p) = (Scratch3::new(), Scratch3::new(), Scratch3::new());
-    let (mut beta, mut l) = (ScratchC::<N>::new(), ScratchC::<N>::new());
-    let (mut eta_scale, mut prev_pdf) = ([0.0f32; MAX_W], [0.0f32; MAX_W]);
-    let mut depth = [0u32; MAX_W];
-    let (mut specular, mut alive) = (0u32, 0u32);
-    let bits = m.bits();
-    for i in 0..F::WIDTH {
-        if bits >> i & 1 == 0 {
-            continue;
-        }
-        let mut s = PathState::<T> {
-            ray: Ray::new(st.o.lane(i), st.d.lane(i)),
-            beta: chan_lane(&st.beta, i),
-            l: chan_lane(&st.l, i),
-            lambda: st.lam[i],
-            eta_scale: st.eta_scale.lane(i),
-            depth: st.depth.lane(i),
-            specular: st.specular.lane(i),
-            prev_pdf: st.prev_pdf.lane(i),
-            prev_p: st.prev_p.lane(i),
-            time: st.time.lane(i),
-            pixel: st.pixel.lane(i),
-            sample: st.sample.lane(i),
-            alive: true,
-            medium: st.medium[i],
-            segments: st.segments[i],
-        };
-        let mut extra = None;
-        let shadow = shade::<T, MOTION, true>(ctx, &mut s, hits.lane(i), &mut extra);
-        for r in [shadow, extra].into_iter().flatten() {
-            stats.shadow_rays += 1;
-            let lam = &s.lambda;
-            let tr = ctx.scene.transmittance_with::<MOTION, T::S>(
-                &r.ray,
-                r.t_max,
-                s.time,
-                r.medium,
-                #[inline(always)]
-                |m, d| T::medium(ctx, m, lam).transmittance(d),
-            );
-            s.l += r.contrib * tr;
-        }
-        o.set(i, s.ray.o);
-        d.set(i, s.ray.d);
-        prev_p.set(i, s.prev_p);
-        beta.set(i, s.beta);
-        l.set(i, s.l);
-        eta_scale[i] = s.eta_scale;
-        prev_pdf[i] = s.prev_pdf;
-        depth[i] = s.depth;
-        specular |= (s.specular as u32) << i;
-        alive |= (s.alive as u32) << i;
-        st.lam[i] = s.lambda;
-        st.medium[i] = s.medium;
-        st.segments[i] = s.segments;
-    }
-    st.o = V3::select(m, o.v3(), st.o);
-    st.d = V3::select(m, d.v3(), st.d);
-    st.prev_p = V3::select(m, prev_p.v3(), st.prev_p);
-    st.beta = select_c(m, beta.load(), st.beta);
-    st.l = select_c(m, l.load(), st.l);
-    st.eta_scale = F::select(m, F::load(&eta_scale), st.eta_scale);
-    st.prev_pdf = F::select(m, F::load(&prev_pdf), st.prev_pdf);
-    st.depth = U::<F>::select(m, U::<F>::from_fn(|i| depth[i]), st.depth);
-    st.specular = st.specular.and_not(m) | (mask_from_bits::<F>(specular) & m);
-    st.alive = st.alive.and_not(m) | (mask_from_bits::<F>(alive) & m);
 }
