@@ -185,6 +185,15 @@ fn channel_probabilities_rgb(beta: Vec3) -> Vec3 {
     Vec3::from_array(channel_probabilities(beta.to_array()))
 }
 
+/// Uniform numbers at both ends of [0, 1) and between.
+const U_EXTREMES: [f32; 5] = [
+    0.0,
+    1e-7,
+    0.5,
+    1.0 - 1.0 / 16_777_216.0,
+    1.0 - f32::EPSILON / 2.0,
+];
+
 #[test]
 fn free_flight_is_finite_in_extreme_media() {
     let mut r = rng(200);
@@ -200,13 +209,7 @@ fn free_flight_is_finite_in_extreme_media() {
         assert_eq!(clear.distance_pdf(0.5, probs), 0.0);
     }
     // σt = 1e6, mixed with thin and empty channels, at the extremes of u.
-    let us = [
-        0.0,
-        1e-7,
-        0.5,
-        1.0 - 2f32.powi(-24),
-        1.0 - f32::EPSILON / 2.0,
-    ];
+    let us = U_EXTREMES;
     let media = [
         HomogeneousMedium::new(Vec3::splat(5e5), Vec3::splat(5e5), 0.0),
         HomogeneousMedium::new(Vec3::new(1e6, 1e-3, 0.0), Vec3::new(0.0, 1e-3, 0.0), 0.0),
@@ -682,13 +685,7 @@ fn lane_free_flight_matches_the_f64_estimator() {
     // (σa, σs, β, t_max, u_channel, u)
     type Case = ([f32; 3], [f32; 3], [f32; 3], f32, f32, f32);
     let mut cases: Vec<Case> = Vec::new();
-    let us = [
-        0.0,
-        1e-7,
-        0.5,
-        1.0 - 2f32.powi(-24),
-        1.0 - f32::EPSILON / 2.0,
-    ];
+    let us = U_EXTREMES;
     let extremes = [
         ([5e5; 3], [5e5; 3]),
         ([1e6, 1e-3, 0.0], [0.0, 1e-3, 0.0]),

@@ -41,7 +41,7 @@ pub trait MediumOps<S>: Copy {
     fn sample_phase(&self, wo: Vec3, u: Vec2) -> (Vec3, f32);
 }
 
-/// [`MediumOps`] for any channel array, through the lane estimators at width 1.
+/// The lane free flight at width 1, as the scalar integrator's [`DistanceSample`].
 #[inline(always)]
 fn free_flight<const N: usize>(
     sigma_s: [f32; N],

@@ -17,6 +17,7 @@ use crate::integrator::path::{
 use crate::integrator::transport::{ChannelArray, MediumOps, Transport};
 use crate::medium::lanes;
 use crate::simd::{Float, Mask, UInt, V3};
+use crate::spectrum::Channels;
 use crate::systems::packet::PacketHit;
 use crate::systems::primitives::NO_MEDIUM;
 
@@ -74,19 +75,28 @@ pub(super) fn shadows<
     let blocked = scene.occluded_packet::<F, MOTION>(o, d, shoot, t_max, st.time);
     let clear = shoot.and_not(blocked);
     let mut tr = ScratchC::<N>::new();
-    if clear.any() {
-        // Extinction of each clear lane's medium (zero outside any: transmittance one).
-        let mut sigma_t = ScratchC::<N>::new();
-        let bits = clear.bits();
-        for i in 0..F::WIDTH {
-            if bits >> i & 1 != 0 && st.medium[i] != NO_MEDIUM {
-                sigma_t.set(i, T::medium(ctx, st.medium[i], &st.lam[i]).sigma_t());
-            }
+    // Clear lanes inside a medium take its transmittance over the whole length; those outside
+    // any transmit everything, and without such lanes no exponential is evaluated at all.
+    let bits = clear.bits();
+    let mut inside = 0u32;
+    let mut sigma_t = ScratchC::<N>::new();
+    for i in 0..F::WIDTH {
+        if bits >> i & 1 != 0 && st.medium[i] != NO_MEDIUM {
+            inside |= 1 << i;
+            sigma_t.set(i, T::medium(ctx, st.medium[i], &st.lam[i]).sigma_t());
         }
+    }
+    if inside != 0 {
         let len = gdot(d, d).sqrt();
         let t: [F; N] = lanes::transmittance(&sigma_t.load::<F>().0, t_max * len);
         for (k, c) in t.iter().enumerate() {
             c.store(&mut tr.0[k]);
+        }
+    }
+    let outside = bits & !inside;
+    for i in 0..F::WIDTH {
+        if outside >> i & 1 != 0 {
+            tr.set(i, T::S::ONE);
         }
     }
     let bits = blocked.bits();
