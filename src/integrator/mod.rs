@@ -282,7 +282,6 @@ fn render_with<T: WithQueues, const MEDIA: bool, const MOTION: bool>(
     progress: &(dyn Fn(u64) + Sync),
 ) -> RenderOutput {
     let lanes = lanes_for(opts.integrator, opts.lanes);
-    let packet = lanes.width() > 1;
     let spectral = if scene.effects.has(Effect::Spectral) {
         transport::SpectralData::new(scene)
     } else {
@@ -314,36 +313,40 @@ fn render_with<T: WithQueues, const MEDIA: bool, const MOTION: bool>(
                 // Width 1 runs inside its entry point so the lane code it inlines (warps,
                 // BSDFs, camera rays, lane math) uses the CPU's FMA.
                 match opts.integrator {
-                    Integrator::Wavefront if packet => crate::simd::dispatch(
-                        lanes,
-                        PacketKernel::<T, MOTION, MEDIA>(
-                            PacketTile {
-                                ctx: &ctx,
-                                tile,
-                                s0,
-                                s1: s0 + n,
-                                film: &mut film,
-                                stats: &mut st,
-                            },
-                            PhantomData,
-                        ),
-                    ),
-                    Integrator::Wavefront => T::with_queues(|q| {
-                        crate::simd::scalar_entry(
-                            #[inline(always)]
-                            || {
-                                wavefront::render_tile::<T, MOTION, MEDIA>(
-                                    &ctx,
-                                    q,
+                    Integrator::Wavefront => {
+                        let wide = crate::simd::dispatch_wide(
+                            lanes,
+                            PacketKernel::<T, MOTION, MEDIA>(
+                                PacketTile {
+                                    ctx: &ctx,
                                     tile,
                                     s0,
-                                    s0 + n,
-                                    &mut film,
-                                    &mut st,
+                                    s1: s0 + n,
+                                    film: &mut film,
+                                    stats: &mut st,
+                                },
+                                PhantomData,
+                            ),
+                        );
+                        if wide.is_none() {
+                            T::with_queues(|q| {
+                                crate::simd::scalar_entry(
+                                    #[inline(always)]
+                                    || {
+                                        wavefront::render_tile::<T, MOTION, MEDIA>(
+                                            &ctx,
+                                            q,
+                                            tile,
+                                            s0,
+                                            s0 + n,
+                                            &mut film,
+                                            &mut st,
+                                        )
+                                    },
                                 )
-                            },
-                        )
-                    }),
+                            })
+                        }
+                    }
                     Integrator::Reference => crate::simd::scalar_entry(
                         #[inline(always)]
                         || {

@@ -243,6 +243,11 @@ impl UInt for u32 {
     }
 }
 
+// The portable forms are bit-exact oracles for tests (no CPU runs them by default: `auto` and
+// forced widths take the native forms), so their operations stay out of line. Inlined, every
+// operation's loop over the lanes was unrolled and re-vectorised inside each whole kernel:
+// the 16 portable packet kernels took 10 of the crate's 15 minutes of build.
+
 /// N boolean lanes.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct PortableMask<const N: usize>(pub [bool; N]);
@@ -271,13 +276,13 @@ macro_rules! portable_binop {
     ($ty:ident, $tr:ident, $m:ident, $tra:ident, $ma:ident, $f:expr) => {
         impl<const N: usize> $tr for $ty<N> {
             type Output = Self;
-            #[inline(always)]
+            #[inline(never)]
             fn $m(self, o: Self) -> Self {
                 $ty(zip(self.0, o.0, $f))
             }
         }
         impl<const N: usize> $tra for $ty<N> {
-            #[inline(always)]
+            #[inline(never)]
             fn $ma(&mut self, o: Self) {
                 *self = $tr::$m(*self, o);
             }
@@ -286,7 +291,7 @@ macro_rules! portable_binop {
     ($ty:ident, $tr:ident, $m:ident, $f:expr) => {
         impl<const N: usize> $tr for $ty<N> {
             type Output = Self;
-            #[inline(always)]
+            #[inline(never)]
             fn $m(self, o: Self) -> Self {
                 $ty(zip(self.0, o.0, $f))
             }
@@ -321,7 +326,7 @@ portable_binop!(PortableMask, BitXor, bitxor, |a, b| a ^ b);
 
 impl<const N: usize> Neg for PortableF32<N> {
     type Output = Self;
-    #[inline(always)]
+    #[inline(never)]
     fn neg(self) -> Self {
         // Flips the sign bit, as `xorps` with -0.0 does (so -NaN keeps its payload).
         PortableF32(map(self.0, |a| f32::from_bits(a.to_bits() ^ 0x8000_0000)))
@@ -330,7 +335,7 @@ impl<const N: usize> Neg for PortableF32<N> {
 
 impl<const N: usize> Not for PortableU32<N> {
     type Output = Self;
-    #[inline(always)]
+    #[inline(never)]
     fn not(self) -> Self {
         PortableU32(map(self.0, |a| !a))
     }
@@ -338,7 +343,7 @@ impl<const N: usize> Not for PortableU32<N> {
 
 impl<const N: usize> Not for PortableMask<N> {
     type Output = Self;
-    #[inline(always)]
+    #[inline(never)]
     fn not(self) -> Self {
         PortableMask(map(self.0, |a| !a))
     }
@@ -346,30 +351,30 @@ impl<const N: usize> Not for PortableMask<N> {
 
 impl<const N: usize> Mask for PortableMask<N> {
     const WIDTH: usize = N;
-    #[inline(always)]
+    #[inline(never)]
     fn splat(b: bool) -> Self {
         PortableMask([b; N])
     }
-    #[inline(always)]
+    #[inline]
     fn from_fn(f: impl FnMut(usize) -> bool) -> Self {
         PortableMask(std::array::from_fn(f))
     }
-    #[inline(always)]
+    #[inline]
     fn lane(self, i: usize) -> bool {
         self.0[i]
     }
-    #[inline(always)]
+    #[inline(never)]
     fn bits(self) -> u32 {
         self.0
             .iter()
             .enumerate()
             .fold(0, |acc, (i, &b)| acc | ((b as u32) << i))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn any(self) -> bool {
         self.0.iter().any(|&b| b)
     }
-    #[inline(always)]
+    #[inline(never)]
     fn all(self) -> bool {
         self.0.iter().all(|&b| b)
     }
@@ -380,89 +385,89 @@ impl<const N: usize> Float for PortableF32<N> {
     type U32 = PortableU32<N>;
     const WIDTH: usize = N;
 
-    #[inline(always)]
+    #[inline(never)]
     fn splat(x: f32) -> Self {
         PortableF32([x; N])
     }
-    #[inline(always)]
+    #[inline]
     fn from_fn(f: impl FnMut(usize) -> f32) -> Self {
         PortableF32(std::array::from_fn(f))
     }
-    #[inline(always)]
+    #[inline]
     fn lane(self, i: usize) -> f32 {
         self.0[i]
     }
-    #[inline(always)]
+    #[inline(never)]
     fn load(s: &[f32]) -> Self {
         PortableF32(s[..N].try_into().expect("slice of N values"))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn store(self, out: &mut [f32]) {
         out[..N].copy_from_slice(&self.0);
     }
-    #[inline(always)]
+    #[inline(never)]
     fn eq(self, o: Self) -> Self::Mask {
         PortableMask(zip(self.0, o.0, |a, b| a == b))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn ne(self, o: Self) -> Self::Mask {
         PortableMask(zip(self.0, o.0, |a, b| a != b))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn lt(self, o: Self) -> Self::Mask {
         PortableMask(zip(self.0, o.0, |a, b| a < b))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn le(self, o: Self) -> Self::Mask {
         PortableMask(zip(self.0, o.0, |a, b| a <= b))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn select(m: Self::Mask, a: Self, b: Self) -> Self {
         PortableF32(std::array::from_fn(
             |i| if m.0[i] { a.0[i] } else { b.0[i] },
         ))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn min(self, o: Self) -> Self {
         PortableF32(zip(self.0, o.0, min1))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn max(self, o: Self) -> Self {
         PortableF32(zip(self.0, o.0, max1))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn mul_add(self, b: Self, c: Self) -> Self {
         PortableF32(std::array::from_fn(|i| self.0[i].mul_add(b.0[i], c.0[i])))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn sqrt(self) -> Self {
         PortableF32(map(self.0, f32::sqrt))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn abs(self) -> Self {
         PortableF32(map(self.0, abs1))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn copysign(self, sign: Self) -> Self {
         PortableF32(zip(self.0, sign.0, copysign1))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn floor(self) -> Self {
         PortableF32(map(self.0, f32::floor))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn round(self) -> Self {
         PortableF32(map(self.0, f32::round_ties_even))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn to_bits(self) -> Self::U32 {
         PortableU32(map(self.0, f32::to_bits))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn from_bits(u: Self::U32) -> Self {
         PortableF32(map(u.0, f32::from_bits))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn to_i32_bits(self) -> Self::U32 {
         PortableU32(map(self.0, cvtt1))
     }
@@ -473,69 +478,69 @@ impl<const N: usize> UInt for PortableU32<N> {
     type Float = PortableF32<N>;
     const WIDTH: usize = N;
 
-    #[inline(always)]
+    #[inline(never)]
     fn splat(x: u32) -> Self {
         PortableU32([x; N])
     }
-    #[inline(always)]
+    #[inline]
     fn from_fn(f: impl FnMut(usize) -> u32) -> Self {
         PortableU32(std::array::from_fn(f))
     }
-    #[inline(always)]
+    #[inline]
     fn lane(self, i: usize) -> u32 {
         self.0[i]
     }
-    #[inline(always)]
+    #[inline(never)]
     fn wrapping_add(self, o: Self) -> Self {
         PortableU32(zip(self.0, o.0, u32::wrapping_add))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn wrapping_sub(self, o: Self) -> Self {
         PortableU32(zip(self.0, o.0, u32::wrapping_sub))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn wrapping_mul(self, o: Self) -> Self {
         PortableU32(zip(self.0, o.0, u32::wrapping_mul))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn shli<const S: u32>(self) -> Self {
         PortableU32(map(self.0, |a| a << S))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn shri<const S: u32>(self) -> Self {
         PortableU32(map(self.0, |a| a >> S))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn srai<const S: u32>(self) -> Self {
         PortableU32(map(self.0, |a| ((a as i32) >> S) as u32))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn shl_var(self, n: Self) -> Self {
         PortableU32(zip(self.0, n.0, shl_var1))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn shr_var(self, n: Self) -> Self {
         PortableU32(zip(self.0, n.0, shr_var1))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn eq(self, o: Self) -> Self::Mask {
         PortableMask(zip(self.0, o.0, |a, b| a == b))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn lt(self, o: Self) -> Self::Mask {
         PortableMask(zip(self.0, o.0, |a, b| a < b))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn lt_i32(self, o: Self) -> Self::Mask {
         PortableMask(zip(self.0, o.0, |a, b| (a as i32) < (b as i32)))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn select(m: Self::Mask, a: Self, b: Self) -> Self {
         PortableU32(std::array::from_fn(
             |i| if m.0[i] { a.0[i] } else { b.0[i] },
         ))
     }
-    #[inline(always)]
+    #[inline(never)]
     fn i32_to_f32(self) -> Self::Float {
         PortableF32(map(self.0, |a| a as i32 as f32))
     }
