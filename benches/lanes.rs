@@ -115,7 +115,8 @@ impl LaneKernel for Generate<'_> {
             // differ in sample index, as in the packet kernel.
             let (x, y, index) = (k.shri::<4>(), F::U32::splat(7), k & F::U32::splat(15));
             let r = if self.rays {
-                let c = prism::integrator::path::camera_rays::<F, false>(&self.ctx, x, y, index);
+                let c =
+                    prism::integrator::generate::camera_rays::<F, false>(&self.ctx, x, y, index);
                 c.d.x + c.d.y + c.d.z
             } else {
                 let pixel = y.wrapping_mul(F::U32::splat(w)).wrapping_add(x);
@@ -172,21 +173,14 @@ fn cornell(size: u32, spp: u32) -> prism::systems::RenderScene {
 
 /// The whole Cornell render (camera rays to film) at each lane form.
 fn render_widths(c: &mut Criterion) {
-    use prism::integrator::{Integrator, RenderOptions, render};
+    use prism::integrator::{RenderOptions, render};
     let scene = cornell(64, 4);
     let mut g = c.benchmark_group("render_widths");
     g.sample_size(10);
     g.throughput(Throughput::Elements(64 * 64 * 4));
-    let mut all = forms();
-    all.push(("portable16".to_string(), Lanes::portable(16)));
-    for (form, lanes) in all {
-        let opts = RenderOptions {
-            sample_offset: 0,
-            spp: 4,
-            time_limit: None,
-            integrator: Integrator::Wavefront,
-            lanes,
-        };
+    // The portable forms are test oracles with out-of-line operations: not timed here.
+    for (form, lanes) in forms().into_iter().filter(|(_, l)| l.is_native()) {
+        let opts = RenderOptions::new(4, lanes);
         g.bench_function(format!("cornell_64x64_4spp_{form}"), |b| {
             b.iter(|| render(&scene, &opts, &|_| {}).stats.samples)
         });
@@ -253,7 +247,7 @@ fn kd_packet(c: &mut Criterion) {
     let mut cam = ([[0.0f32; 4096]; 3], [[0.0f32; 4096]; 3]);
     for k in 0..4096u32 {
         let (p, idx) = (k / 4, k % 4);
-        let r = prism::integrator::path::camera_rays::<f32, false>(&ctx, p % 32, p / 32, idx);
+        let r = prism::integrator::generate::camera_rays::<f32, false>(&ctx, p % 32, p / 32, idx);
         for (a, v) in [(&mut cam.0, r.o), (&mut cam.1, r.d)] {
             (a[0][k as usize], a[1][k as usize], a[2][k as usize]) = (v.x, v.y, v.z);
         }

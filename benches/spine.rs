@@ -3,7 +3,7 @@
 use criterion::{Criterion, criterion_group, criterion_main};
 use glam::{Vec2, Vec3};
 use prism::geometry::{Aabb, Ray};
-use prism::integrator::{Ctx, Integrator, RenderOptions, path::camera_ray, render};
+use prism::integrator::{Ctx, RenderOptions, generate::camera_rays as lane_camera_rays, render};
 use prism::kdtree::{KdParams, KdTree};
 use prism::sampling::{Sampler, SamplerKind, square_to_uniform_sphere};
 use prism::systems::{RenderScene, prepare};
@@ -35,15 +35,9 @@ fn scene_text(text: &str, path: &Path, w: u32, h: u32) -> RenderScene {
     )
 }
 
-/// Wavefront render options for `spp` samples per pixel.
+/// Render options for `spp` samples per pixel at the widest native width.
 fn wavefront(spp: u32) -> RenderOptions {
-    RenderOptions {
-        sample_offset: 0,
-        spp,
-        time_limit: None,
-        integrator: Integrator::Wavefront,
-        lanes: prism::simd::Lanes::auto(),
-    }
+    RenderOptions::new(spp, prism::simd::Lanes::auto())
 }
 
 fn random_boxes(n: usize) -> Vec<Aabb> {
@@ -93,8 +87,8 @@ fn camera_rays<const MOTION: bool>(ctx: &Ctx) -> Vec2 {
     let mut acc = Vec2::ZERO;
     for y in 0..64 {
         for x in 0..64 {
-            let s = camera_ray::<prism::integrator::transport::Rgb, MOTION>(ctx, x, y, 0);
-            acc += s.ray.d.truncate() + s.time;
+            let r = lane_camera_rays::<f32, MOTION>(ctx, x, y, 0);
+            acc += glam::Vec3::from(r.d).truncate() + r.time;
         }
     }
     acc
@@ -133,17 +127,11 @@ fn integrator(c: &mut Criterion) {
     let mut g = c.benchmark_group("integrator");
     g.sample_size(10);
     let scene = cornell(64, 4);
-    for (name, integrator) in [
-        ("wavefront", Integrator::Wavefront),
-        ("reference", Integrator::Reference),
+    for (name, lanes) in [
+        ("w1", prism::simd::Lanes::scalar()),
+        ("auto", prism::simd::Lanes::auto()),
     ] {
-        let opts = RenderOptions {
-            sample_offset: 0,
-            spp: 4,
-            time_limit: None,
-            integrator,
-            lanes: prism::simd::Lanes::auto(),
-        };
+        let opts = RenderOptions::new(4, lanes);
         g.bench_function(format!("cornell_64x64_4spp_{name}"), |b| {
             b.iter(|| render(&scene, &opts, &|_| {}).stats.samples)
         });

@@ -1,8 +1,9 @@
 //! prism: a physically based spectral path tracer.
 //!
 //! A RON scene becomes a `hecs` world (`scene_file`); systems flatten it into arrays, a
-//! kd-tree and a light list (`systems`, `kdtree`); a wavefront integrator pushes batches of
-//! rays through them (`integrator`); the film writes PNG or EXR (`film`).
+//! kd-tree and a light list (`systems`, `kdtree`); the integrator traces packets of paths
+//! through them, one per SIMD lane (`integrator`); the film accumulates them and writes PNG
+//! or EXR (`film`).
 
 // `simd` alone may hold `unsafe` (intrinsics behind CPU feature detection); `tests/lanes.rs`
 // checks that no other module does.

@@ -4,7 +4,6 @@
 mod common;
 use assert_cmd::cargo::CommandCargoExt;
 use common::render::{run, scene_file};
-use prism::integrator::Integrator;
 use prism::systems::Effect;
 use std::path::Path;
 use std::process::Command;
@@ -88,9 +87,9 @@ fn forcing_the_lens_on_a_pinhole_scene_changes_nothing_beyond_noise() {
     for (name, factor) in [("cornell", 0.01), ("caustics", 1.0)] {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("scenes/{name}.ron"));
         let mut s = scene_file(&path, &small);
-        let plain = run(&s, Integrator::Wavefront).image();
+        let plain = run(&s).image();
         s.effects.force(Effect::Lens).unwrap();
-        let forced = run(&s, Integrator::Wavefront).image();
+        let forced = run(&s).image();
         let m = prism::film::compare(&forced, &plain).unwrap().relmse;
         // A zero aperture only re-derives each direction through the focal point: rounding.
         // Diffuse transport carries that on smoothly; chains of glass and mirror bounces are
@@ -98,7 +97,7 @@ fn forcing_the_lens_on_a_pinhole_scene_changes_nothing_beyond_noise() {
         // fraction of the difference between two independent renders: 1 % for the diffuse
         // box, all of it for the glass.
         let other = scene_file(&path, &[small[0], small[1], small[2], ("render.seed", "2")]);
-        let noise = prism::film::compare(&run(&other, Integrator::Wavefront).image(), &plain)
+        let noise = prism::film::compare(&run(&other).image(), &plain)
             .unwrap()
             .relmse;
         let bound = factor * noise;
@@ -119,16 +118,16 @@ fn forcing_media_or_textures_on_a_scene_without_them_changes_nothing_beyond_nois
     for name in ["cornell", "caustics"] {
         let path = Path::new(env!("CARGO_MANIFEST_DIR")).join(format!("scenes/{name}.ron"));
         let base = scene_file(&path, &small);
-        let plain = run(&base, Integrator::Wavefront).image();
+        let plain = run(&base).image();
         let other = scene_file(&path, &[small[0], small[1], small[2], ("render.seed", "2")]);
-        let noise = prism::film::compare(&run(&other, Integrator::Wavefront).image(), &plain)
+        let noise = prism::film::compare(&run(&other).image(), &plain)
             .unwrap()
             .relmse;
         for effect in [Effect::Media, Effect::Textures, Effect::NormalMaps] {
             let mut s = scene_file(&path, &small);
             assert!(!s.effects.has(effect));
             s.effects.force(effect).unwrap();
-            let forced = run(&s, Integrator::Wavefront).image();
+            let forced = run(&s).image();
             let m = prism::film::compare(&forced, &plain).unwrap().relmse;
             assert!(
                 m < 0.01 * noise,

@@ -1,47 +1,29 @@
 //! Dispersion: Snell's law per wavelength, and where `scenes/prism.ron` puts each colour.
 
 use glam::Vec3;
-use prism::integrator::Ctx;
-use prism::integrator::path::{camera_ray, shade};
-use prism::integrator::transport::{Spectral, SpectralData};
+use prism::integrator::transport::{Spectral, Transport};
+use prism::integrator::{RenderOptions, render};
 use prism::spectrum::{IorModel, IorPreset, SampledSpectrum, Wavelengths};
 use std::path::Path;
 
 /// Renders `scene` with every path carrying the single wavelength `lambda` (a monochromatic
-/// image of the hero wavelength's radiance): the renderer's own camera, shading and
-/// transport, only the wavelength sample fixed.
+/// image of that wavelength's radiance): the renderer's own camera, shading and transport,
+/// only the wavelength sample fixed. The film receives radiance L as the colour L·v with
+/// v = rgb(λ); the projection on v recovers L.
 fn monochromatic(scene: &prism::systems::RenderScene, lambda: f32) -> Vec<f32> {
-    let data = SpectralData::new(scene);
-    let ctx = Ctx::new(scene, false).with_spectral(&data);
-    let (w, h) = (scene.settings.width, scene.settings.height);
-    let spp = scene.settings.spp;
-    let mut img = vec![0.0f32; (w * h) as usize];
-    for y in 0..h {
-        for x in 0..w {
-            let mut sum = 0.0;
-            for k in 0..spp {
-                let mut s = camera_ray::<Spectral, false>(&ctx, x, y, k);
-                s.lambda = Wavelengths {
-                    lambda: [lambda; 4],
-                    pdf: [1.0, 0.0, 0.0, 0.0],
-                };
-                s.beta = SampledSpectrum([1.0, 0.0, 0.0, 0.0]);
-                while s.alive {
-                    let hit = scene.intersect::<false>(&s.ray, f32::INFINITY, 0.0);
-                    let mut extra = None;
-                    let first = shade::<Spectral, false, false>(&ctx, &mut s, hit, &mut extra);
-                    for r in [first, extra].into_iter().flatten() {
-                        if !scene.occluded::<false>(&r.ray, r.t_max, 0.0) {
-                            s.l += r.contrib;
-                        }
-                    }
-                }
-                sum += s.l[0];
-            }
-            img[(y * w + x) as usize] = sum / spp as f32;
-        }
-    }
-    img
+    let mut opts = RenderOptions::new(scene.settings.spp, prism::simd::Lanes::auto());
+    opts.monochromatic = Some(lambda);
+    let img = render(scene, &opts, &|_| {}).image();
+    let lam = Wavelengths {
+        lambda: [lambda; 4],
+        pdf: [1.0, 0.0, 0.0, 0.0],
+    };
+    let v = Spectral::to_rgb(SampledSpectrum([1.0, 0.0, 0.0, 0.0]), &lam);
+    assert!(v.length_squared() > 0.0);
+    img.pixels
+        .iter()
+        .map(|p| Vec3::from(*p).dot(v) / v.length_squared())
+        .collect()
 }
 
 /// The prism's cross-section (x, z) from the first three vertices of `assets/prism.obj`.

@@ -4,7 +4,6 @@
 mod common;
 use common::render::{image, scene};
 use prism::film::Image;
-use prism::integrator::Integrator;
 
 /// Independent renders (one per seed) of `text`, whose `{seed}` is replaced.
 fn renders(text: &str, seeds: u32) -> Vec<Image> {
@@ -239,13 +238,14 @@ fn a_white_medium_inside_a_box_of_rect_emitters_glows_at_their_radiance() {
     );
 }
 
-/// Both integrators take the same samples through the same shading code: with equiangular
-/// sampling towards an area light they give the same sums up to summation order.
+/// Width 1 and 16 portable lanes take the same samples through the same code: with
+/// equiangular sampling towards an area light (set up per lane in f64, the rest in lanes)
+/// they give the same sums up to rounding.
 #[test]
-fn wavefront_matches_reference_with_area_equiangular() {
+fn widths_agree_with_area_equiangular() {
     let s = scene(&fog_with(SPHERE, true, "Nee").replace("{seed}", "7"));
-    let a = common::render::run(&s, Integrator::Wavefront);
-    let b = common::render::run(&s, Integrator::Reference);
+    let a = common::render::run_at(&s, prism::simd::Lanes::scalar());
+    let b = common::render::run_at(&s, prism::simd::Lanes::portable(16));
     assert_eq!(a.stats.rays, b.stats.rays);
     assert_eq!(a.stats.shadow_rays, b.stats.shadow_rays);
     for (pa, pb) in a.sums.iter().zip(&b.sums) {
@@ -272,7 +272,7 @@ fn extreme_media_around_an_area_light_stay_finite() {
                 "sigma_a: Rgb(0.02, 0.015, 0.01), sigma_s: Rgb(0.1, 0.12, 0.15), g: 0.4",
                 &format!("sigma_a: Rgb({sa:?}, {sa:?}, {sa:?}), sigma_s: Rgb({ss:?}, 0.0, {ss:?}), g: {g:?}"),
             );
-        let out = common::render::run(&scene(&text), Integrator::Wavefront);
+        let out = common::render::run(&scene(&text));
         assert_eq!(out.stats.dropped, 0, "σa {sa}, σs {ss}, g {g}");
         assert!(
             out.sums.iter().flatten().all(|v| v.is_finite()),

@@ -7,8 +7,7 @@ mod common;
 use common::render::scene_file;
 use glam::{Vec2, Vec3, Vec3Swizzles};
 use prism::integrator::Ctx;
-use prism::integrator::path::{camera_ray, camera_rays};
-use prism::integrator::transport::Rgb;
+use prism::integrator::generate::camera_rays;
 use prism::sampling::warp::{self, lanes as lw};
 use prism::sampling::{Sampler, SamplerKind};
 use prism::simd::{self, Float, LaneKernel, Lanes, UInt, V3};
@@ -276,11 +275,11 @@ fn lane_camera_rays_are_the_scalar_camera_rays() {
             .iter()
             .map(|&(x, y, i)| {
                 let p = if motion {
-                    camera_ray::<Rgb, true>(&ctx, x, y, i)
+                    camera_rays::<f32, true>(&ctx, x, y, i)
                 } else {
-                    camera_ray::<Rgb, false>(&ctx, x, y, i)
+                    camera_rays::<f32, false>(&ctx, x, y, i)
                 };
-                let (o, d) = (p.ray.o, p.ray.d);
+                let (o, d) = (p.o, p.d);
                 [o.x, o.y, o.z, d.x, d.y, d.z, p.time]
                     .iter()
                     .map(|v| v.to_bits())

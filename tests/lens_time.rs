@@ -3,7 +3,6 @@
 mod common;
 use common::render::{image, run, scene, scene_file};
 use prism::film::Image;
-use prism::integrator::Integrator;
 use prism::systems::Effect;
 use std::path::Path;
 
@@ -153,7 +152,7 @@ fn static_pinhole_scenes_draw_no_lens_or_time_samples() {
     assert!(!s.effects.has(Effect::Lens) && !s.effects.has(Effect::Motion));
     // The image is bit for bit the one the renderer made before lens and time sampling
     // existed: absent effects leave every other sample dimension where it was.
-    let out = run(&s, Integrator::Wavefront);
+    let out = run(&s);
     let mut h: u64 = 0xcbf2_9ce4_8422_2325;
     for p in out.image().pixels {
         for c in p {
@@ -175,9 +174,9 @@ const GOLDEN_CORNELL_24: u64 = 0xbcbd_2f59_a431_6ccd;
 fn forcing_motion_on_a_static_scene_changes_nothing() {
     let text = moving_disc(0.0);
     let mut a = scene(&text);
-    let plain = run(&a, Integrator::Wavefront);
+    let plain = run(&a);
     a.effects.force(Effect::Motion).unwrap();
-    let forced = run(&a, Integrator::Wavefront);
+    let forced = run(&a);
     assert_eq!(plain.sums, forced.sums);
 }
 

@@ -2,7 +2,6 @@
 
 mod common;
 use common::render::{image, mean_where, run, scene};
-use prism::integrator::Integrator;
 
 fn on_sphere(x: u32, y: u32) -> bool {
     let (dx, dy) = (x as f32 + 0.5 - 16.0, y as f32 + 0.5 - 16.0);
@@ -82,22 +81,15 @@ fn a_medium_with_no_extinction_changes_nothing() {
 )"#
         )
     };
-    let plain = run(&scene(&text("")), Integrator::Wavefront).image();
-    let empty = run(
-        &scene(&text(
-            r#"(name: "air", shape: Box(min: (-3.0, -0.1, -3.0), max: (3.0, 3.5, 3.0)), medium: (sigma_a: Rgb(0.0, 0.0, 0.0), sigma_s: Rgb(0.0, 0.0, 0.0))),"#,
-        )),
-        Integrator::Wavefront,
-    );
+    let plain = run(&scene(&text(""))).image();
+    let empty = run(&scene(&text(
+        r#"(name: "air", shape: Box(min: (-3.0, -0.1, -3.0), max: (3.0, 3.5, 3.0)), medium: (sigma_a: Rgb(0.0, 0.0, 0.0), sigma_s: Rgb(0.0, 0.0, 0.0))),"#,
+    )));
     assert_eq!(empty.stats.dropped, 0);
     // The same samples drive both (boundaries only re-spawn rays a rounding step further),
     // so the difference must lie far below the noise between two independent renders.
     let m = prism::film::compare(&empty.image(), &plain).unwrap().relmse;
-    let other = run(
-        &scene(&text("").replace("seed: 5", "seed: 6")),
-        Integrator::Wavefront,
-    )
-    .image();
+    let other = run(&scene(&text("").replace("seed: 5", "seed: 6"))).image();
     let noise = prism::film::compare(&other, &plain).unwrap().relmse;
     assert!(m < 0.1 * noise, "{m} vs noise {noise}");
 }

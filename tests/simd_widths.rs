@@ -6,20 +6,17 @@
 
 mod common;
 
-use prism::integrator::{Integrator, RenderOptions, RenderOutput, render};
+use prism::integrator::{RenderOptions, RenderOutput, render};
 use prism::simd::Lanes;
 use prism::systems::RenderScene;
 use std::path::Path;
 
 fn run(scene: &RenderScene, lanes: Lanes) -> RenderOutput {
-    let opts = RenderOptions {
-        sample_offset: 0,
-        spp: scene.settings.spp,
-        time_limit: None,
-        integrator: Integrator::Wavefront,
-        lanes,
-    };
-    render(scene, &opts, &|_| {})
+    render(
+        scene,
+        &RenderOptions::new(scene.settings.spp, lanes),
+        &|_| {},
+    )
 }
 
 fn close(a: f32, b: f32) -> bool {

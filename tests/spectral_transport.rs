@@ -5,7 +5,6 @@
 mod common;
 use common::render::{run, scene};
 use prism::film::Image;
-use prism::integrator::Integrator;
 use prism::systems::Effect;
 
 fn render(text: &str, spectral: bool) -> Image {
@@ -14,7 +13,7 @@ fn render(text: &str, spectral: bool) -> Image {
         s.effects.force(Effect::Spectral).unwrap();
     }
     assert_eq!(s.effects.has(Effect::Spectral), spectral);
-    run(&s, Integrator::Wavefront).image()
+    run(&s).image()
 }
 
 fn means(img: &Image) -> [f64; 3] {
@@ -143,7 +142,7 @@ Scene(
         s.effects.has(Effect::Spectral),
         "a dispersive IOR turns SPECTRAL on"
     );
-    let img = run(&s, Integrator::Wavefront).image();
+    let img = run(&s).image();
     let m = means(&img);
     for (c, v) in m.iter().enumerate() {
         assert!((v / 0.5 - 1.0).abs() < 0.02, "channel {c}: {v}");

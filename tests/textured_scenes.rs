@@ -5,7 +5,6 @@ mod common;
 use common::render::{mean_where, run, scene};
 use glam::Vec3;
 use prism::geometry::Ray;
-use prism::integrator::Integrator;
 use prism::sampling::{Sampler, SamplerKind, square_to_uniform_sphere};
 use std::path::Path;
 
@@ -36,11 +35,10 @@ fn lit_wall(normal_map: &str) -> String {
 fn a_flat_normal_map_renders_like_no_normal_map() {
     let d = tempfile::tempdir().unwrap();
     let flat = png(d.path(), "flat.png", [128, 128, 255]);
-    let plain = run(&scene(&lit_wall("")), Integrator::Wavefront).image();
-    let mapped = run(
-        &scene(&lit_wall(&format!(", normal_map: Image(path: \"{flat}\")"))),
-        Integrator::Wavefront,
-    )
+    let plain = run(&scene(&lit_wall(""))).image();
+    let mapped = run(&scene(&lit_wall(&format!(
+        ", normal_map: Image(path: \"{flat}\")"
+    ))))
     .image();
     // Code 128 is 1/255 off zero, so the normal tilts by under 0.006 rad: a change far below
     // the noise of 32 samples, yet the same samples are drawn, so the images nearly match.
@@ -63,7 +61,7 @@ fn a_strongly_tilted_normal_map_keeps_the_furnace_at_most_one() {
 )"#
     );
     let s = scene(&text);
-    let out = run(&s, Integrator::Wavefront);
+    let out = run(&s);
     assert_eq!(out.stats.dropped, 0);
     let img = out.image();
     let m = mean_where(&img, 1, |x, y| {

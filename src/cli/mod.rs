@@ -5,7 +5,7 @@ pub mod frames;
 mod progress;
 
 use crate::film::{self, ImageMeta, PngOptions};
-use crate::integrator::{self, Integrator, RenderOptions};
+use crate::integrator::{self, RenderOptions};
 use crate::kdtree::KdParams;
 use crate::scene_file::{self, LoadedScene};
 use crate::systems::{self, Effect, RenderScene};
@@ -112,7 +112,7 @@ pub struct RenderArgs {
     /// Overrides render.simd. Pin it on a farm: widths round differently.
     #[arg(long)]
     pub simd: Option<crate::simd::SimdChoice>,
-    /// Use the per-path reference integrator instead of the wavefront one.
+    /// Render at width 1, the reference the wider packets are tested against (as `--simd 1`).
     #[arg(long, hide = true)]
     pub reference: bool,
     /// Print render statistics.
@@ -405,18 +405,18 @@ fn render_to_file(
     label: &str,
 ) -> Result<integrator::RenderOutput, CliError> {
     let spp = rs.settings.spp;
-    let lanes = crate::simd::Lanes::resolve(a.simd.unwrap_or(rs.settings.simd))
-        .map_err(|e| CliError(e.to_string()))?;
+    let choice = if a.reference {
+        crate::simd::SimdChoice::W1
+    } else {
+        a.simd.unwrap_or(rs.settings.simd)
+    };
+    let lanes = crate::simd::Lanes::resolve(choice).map_err(|e| CliError(e.to_string()))?;
     let opts = RenderOptions {
         sample_offset: a.sample_offset,
         spp,
         time_limit: a.time_limit,
-        integrator: if a.reference {
-            Integrator::Reference
-        } else {
-            Integrator::Wavefront
-        },
         lanes,
+        monochromatic: None,
     };
     let total = rs.settings.width as u64 * rs.settings.height as u64 * spp as u64;
     let bar = progress::Progress::new(total, a.quiet, label);

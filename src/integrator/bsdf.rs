@@ -15,8 +15,8 @@
 //!   refraction differs between them here: radiance is compressed by 1/η² entering a denser
 //!   medium, importance is not.
 //!
-//! The scalar functions are these at width 1, so the per-path integrator and the packet kernel
-//! simulate the same physics bit for bit.
+//! The scalar functions are these at width 1, so every width simulates the same physics bit
+//! for bit.
 
 use crate::simd::{Float, UInt, V3};
 use crate::spectrum::Channels;

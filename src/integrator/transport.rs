@@ -8,7 +8,7 @@
 //! converted to linear sRGB (the conversion is linear, so converting each sample equals
 //! converting the accumulated XYZ).
 
-use super::path::Ctx;
+use super::ctx::Ctx;
 use crate::medium::{DistanceSample, HomogeneousMedium, lanes};
 use crate::spectrum::{
     Channels, EmitterSpectrum, IorModel, RgbIlluminant, RgbSigmoid, RgbUnbounded, SampledSpectrum,
@@ -24,8 +24,8 @@ pub const LAMBDA_D: f32 = 587.56;
 
 /// A homogeneous medium with coefficients in the transport's channels.
 ///
-/// The estimators are [`crate::medium::lanes`]' at width 1, the functions the packet kernel
-/// runs over lanes, so both integrators take the same decisions from the same numbers. Their
+/// The estimators are [`crate::medium::lanes`]' at width 1, the functions the kernel runs
+/// over lanes, so the per-lane steps take the same decisions from the same numbers. Their
 /// methods are always inlined: out of the lane kernels' `target_feature` entry points the
 /// lane math would call `fmaf` and `rintf` for every fused multiply-add and rounding.
 pub trait MediumOps<S>: Copy {
@@ -300,7 +300,7 @@ impl ChannelArray<4> for SampledSpectrum {
 
 /// What a path carries, and how the scene's colours become that.
 pub trait Transport: Copy + Send + Sync + 'static {
-    /// Colours depend on the path's wavelengths (so the packet kernel evaluates them per lane;
+    /// Colours depend on the path's wavelengths (so the kernel evaluates them per lane;
     /// RGB colours are the same for every lane).
     const SPECTRAL: bool;
     type S: Channels;
@@ -402,9 +402,13 @@ impl Transport for Spectral {
 
     #[inline]
     fn wavelengths(ctx: &Ctx, pixel: u32, index: u32) -> Wavelengths {
-        let u = ctx
-            .sampler
-            .get_1d(pixel, index, super::path::DIM_WAVELENGTH);
+        if let Some(lambda) = ctx.monochromatic {
+            return Wavelengths {
+                lambda: [lambda; 4],
+                pdf: [1.0, 0.0, 0.0, 0.0],
+            };
+        }
+        let u = ctx.sampler.get_1d(pixel, index, super::ctx::DIM_WAVELENGTH);
         let mut lam = Wavelengths::sample_visible(u);
         if ctx.single_wavelength {
             lam.terminate_secondary();

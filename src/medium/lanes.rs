@@ -1,5 +1,5 @@
-//! The medium's estimators over lanes: the one implementation both integrators run (the
-//! per-path one at width 1), so a lane's medium events are the per-path integrator's.
+//! The medium's estimators over lanes: the one implementation every width runs (per lane or
+//! over lanes), so a lane's medium events are those of width 1.
 //!
 //! The f64 functions of [`super::distance`] stay as the accurate statement of the same
 //! estimators, against which these are tested. Here everything is f32, so the ratios of

@@ -2,7 +2,7 @@
 //! more configurations of a scene.
 
 use crate::film::{self, Image, ImageMeta, PngOptions};
-use crate::integrator::{Integrator, RenderOptions, render};
+use crate::integrator::{RenderOptions, render};
 use crate::kdtree::KdParams;
 use crate::scene_file::{self, LoadedScene};
 use crate::systems::{self, Effect};
@@ -193,8 +193,8 @@ fn timed_render(
             sample_offset: offset,
             spp,
             time_limit: None,
-            integrator: Integrator::Wavefront,
             lanes: crate::simd::Lanes::auto(),
+            monochromatic: None,
         },
         &|_| {},
     );

@@ -1,7 +1,7 @@
 //! What each effect costs: time per sample of a scene as it is, and with every effect it does
 //! not need forced on.
 
-use crate::integrator::{Integrator, RenderOptions, render};
+use crate::integrator::{RenderOptions, render};
 use crate::kdtree::KdParams;
 use crate::scene_file;
 use crate::systems::{self, Effect};
@@ -14,8 +14,8 @@ fn ns_per_sample(rs: &systems::RenderScene, spp: u32, runs: usize) -> f64 {
         sample_offset: 0,
         spp,
         time_limit: None,
-        integrator: Integrator::Wavefront,
         lanes: crate::simd::Lanes::auto(),
+        monochromatic: None,
     };
     let mut t: Vec<f64> = (0..runs)
         .map(|_| {

@@ -500,52 +500,6 @@ pub trait LaneKernel {
     fn run<F: Float>(self) -> Self::Output;
 }
 
-/// Runs `f` inside width 1's entry point, so the lane code it inlines uses the CPU's FMA
-/// (outside it, `f32::mul_add` compiles to a call into the runtime's `fmaf`). Mark the closure
-/// `#[inline(always)]`, and what it calls likewise: code that is not inlined is compiled for
-/// the baseline CPU.
-#[inline(always)]
-pub fn scalar_entry<R>(f: impl FnOnce() -> R) -> R {
-    struct Once<C>(C);
-    impl<R, C: FnOnce() -> R> LaneKernel for Once<C> {
-        type Output = R;
-        #[inline(always)]
-        fn run<F: Float>(self) -> R {
-            (self.0)()
-        }
-    }
-    match Lanes::scalar().0 {
-        // SAFETY: `Lanes::scalar` names `ScalarFma` only after `is_x86_feature_detected!`
-        // found FMA, the one feature `entry_fma` enables.
-        #[cfg(target_arch = "x86_64")]
-        Form::ScalarFma => unsafe { x86::entry_fma(Once(f)) },
-        // Only the two width-1 forms are instantiated: the closure is a whole integrator,
-        // and a copy of it per lane form would be dead code that multiplies build time.
-        _ => f(),
-    }
-}
-
-/// Runs `k` at the lane type of `lanes` if `lanes` is wider than 1, else returns `None`
-/// without instantiating `k` at width 1. For kernels whose width-1 form is another function
-/// (the packet kernel, whose width 1 is the per-path integrator): each form of a whole
-/// integrator costs minutes of build time.
-pub fn dispatch_wide<K: LaneKernel>(lanes: Lanes, k: K) -> Option<K::Output> {
-    match lanes.0 {
-        Form::Scalar => None,
-        #[cfg(target_arch = "x86_64")]
-        Form::ScalarFma => None,
-        Form::Portable8 => Some(k.run::<PortableF32<8>>()),
-        Form::Portable16 => Some(k.run::<PortableF32<16>>()),
-        // SAFETY: a `Lanes` naming a native form is built only by `native8` and `native16`
-        // after `is_x86_feature_detected!` found every feature the entry point enables.
-        #[cfg(target_arch = "x86_64")]
-        Form::Avx2 => Some(unsafe { x86::entry_avx2(k) }),
-        #[cfg(target_arch = "x86_64")]
-        // SAFETY: as above.
-        Form::Avx512 => Some(unsafe { x86::entry_avx512(k) }),
-    }
-}
-
 /// Runs `k` instantiated at the lane type of `lanes`, inside an entry point compiled for that
 /// width's instruction set.
 pub fn dispatch<K: LaneKernel>(lanes: Lanes, k: K) -> K::Output {

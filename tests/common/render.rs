@@ -1,7 +1,7 @@
 //! Rendering helpers shared by the integration tests.
 
 use prism::film::Image;
-use prism::integrator::{Integrator, RenderOptions, RenderOutput, render};
+use prism::integrator::{RenderOptions, RenderOutput, render};
 use prism::kdtree::KdParams;
 use prism::scene_file::load_str;
 use prism::systems::{RenderScene, prepare};
@@ -22,29 +22,22 @@ pub fn scene_file(path: &Path, overrides: &[(&str, &str)]) -> RenderScene {
     prepare(&loaded, &KdParams::default())
 }
 
-pub fn run(scene: &RenderScene, integrator: Integrator) -> RenderOutput {
-    run_at(scene, integrator, prism::simd::Lanes::auto())
+pub fn run(scene: &RenderScene) -> RenderOutput {
+    run_at(scene, prism::simd::Lanes::auto())
 }
 
 /// [`run`] at a given lane width.
 #[allow(dead_code)]
-pub fn run_at(
-    scene: &RenderScene,
-    integrator: Integrator,
-    lanes: prism::simd::Lanes,
-) -> RenderOutput {
-    let opts = RenderOptions {
-        sample_offset: 0,
-        spp: scene.settings.spp,
-        time_limit: None,
-        integrator,
-        lanes,
-    };
-    render(scene, &opts, &|_| {})
+pub fn run_at(scene: &RenderScene, lanes: prism::simd::Lanes) -> RenderOutput {
+    render(
+        scene,
+        &RenderOptions::new(scene.settings.spp, lanes),
+        &|_| {},
+    )
 }
 
 pub fn image(text: &str) -> Image {
-    run(&scene(text), Integrator::Wavefront).image()
+    run(&scene(text)).image()
 }
 
 /// Mean of one channel over the pixels selected by `keep(x, y)`.

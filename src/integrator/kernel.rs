@@ -1,0 +1,115 @@
+//! The kernel: one worker traces `F::WIDTH` paths at once, one per lane, their state in
+//! lane-SoA registers, and refills a lane with the tile's next sample as soon as its path
+//! ends. The stages run in pipeline order, each a function over the packet in its own file:
+//!
+//! ```text
+//! generate → intersect → media → surface → emission → material (light + shadow) → roulette
+//!    ↑        (packet kd walk)   (MEDIA)                                                |
+//!    |________________________________ film ←___________________________________________|
+//! ```
+//!
+//! Width 1 is this same code over `f32`: the reference integrator, the oracle every wider
+//! packet is tested against (`tests/simd_widths.rs`).
+
+use super::bsdf::LaneChannels;
+use super::ctx::Ctx;
+use super::state::{C, M, MAX_W, Paths, U, chan_lane};
+use super::surface::{CLASS_BOUNDARY, CLASS_NONE};
+use super::transport::{ChannelArray, Transport};
+use super::{RenderStats, emission, generate, material, media, surface};
+use crate::film::{Tile, TileFilm};
+use crate::geometry::offset_ray_origin_lanes;
+use crate::simd::{Float, Mask, UInt, V3};
+use crate::systems::primitives::NO_MEDIUM;
+
+/// Renders samples `s0..s1` of every pixel of `tile` with packets of `F::WIDTH` paths, adding
+/// each finished path's radiance to `film`.
+#[inline(always)]
+pub fn render_tile<
+    F: Float,
+    T: Transport<S: ChannelArray<N>>,
+    const N: usize,
+    const MOTION: bool,
+    const MEDIA: bool,
+>(
+    ctx: &Ctx,
+    tile: &Tile,
+    s0: u32,
+    s1: u32,
+    film: &mut TileFilm,
+    stats: &mut RenderStats,
+) {
+    let spp = (s1 - s0) as usize;
+    let total = tile.pixels() * spp;
+    let mut next = 0usize;
+    let zero3 = V3::<F>::zero();
+    let mut st = Paths::<F, T, N> {
+        o: zero3,
+        d: zero3,
+        beta: C::<F, N>::splat(F::zero()),
+        l: C::<F, N>::splat(F::zero()),
+        lam: [T::Lambda::default(); MAX_W],
+        eta_scale: F::one(),
+        depth: U::<F>::splat(0),
+        specular: M::<F>::splat(false),
+        prev_pdf: F::zero(),
+        prev_p: zero3,
+        time: F::zero(),
+        pixel: U::<F>::splat(0),
+        sample: U::<F>::splat(0),
+        alive: M::<F>::splat(false),
+        medium: [NO_MEDIUM; MAX_W],
+        segments: [0; MAX_W],
+    };
+    let scene = ctx.scene;
+    let max_depth = U::<F>::splat(ctx.max_depth);
+    loop {
+        generate::refill::<F, T, N, MOTION>(ctx, tile, s0, spp, total, &mut next, &mut st);
+        let started = st.alive;
+        if started.none() {
+            break;
+        }
+        stats.rays += started.count() as u64;
+        stats.lane_slots += F::WIDTH as u64;
+        let hits = scene.intersect_packet::<F, MOTION>(st.o, st.d, st.alive, st.time);
+        // MEDIA: lanes in a medium first sample their flight; those that scatter there are
+        // done with this vertex, the rest reach their hit.
+        let in_medium = if MEDIA {
+            media::free_flight::<F, T, N, MOTION>(ctx, &mut st, &hits, started, stats)
+        } else {
+            M::<F>::splat(false)
+        };
+        let at = st.alive.and_not(in_medium);
+        let sf = surface::surfaces::<F, T, N, MOTION, MEDIA>(ctx, &st, &hits, at);
+        // Misses see the environment; emitters add their radiance and absorb the rest.
+        emission::escaped::<F, T, N>(ctx, &mut st, at.and_not(sf.hit));
+        emission::emitters(&mut st, &sf);
+        let boundary = sf.hit & sf.class.eq(U::<F>::splat(CLASS_BOUNDARY));
+        let scatters = !sf.class.eq(U::<F>::splat(CLASS_NONE)) & !boundary;
+        let surface = sf.hit & scatters & st.depth.lt(max_depth);
+        st.alive = (st.alive & in_medium) | surface | boundary;
+        if surface.any() {
+            material::scatter::<F, T, N, MOTION, MEDIA>(ctx, &mut st, &sf, surface, stats);
+        }
+        if MEDIA && boundary.any() {
+            // Carry on in the same direction, in the medium beyond.
+            st.o = V3::select(boundary, offset_ray_origin_lanes(sf.p, -sf.nf), st.o);
+            let bits = boundary.bits();
+            let prims = &scene.prims;
+            for i in 0..F::WIDTH {
+                if bits >> i & 1 != 0 {
+                    st.medium[i] =
+                        prims.medium_after_crossing(sf.prim[i], sf.front.lane(i), st.medium[i]);
+                }
+            }
+        }
+        // Finished paths go to the film.
+        let ended = started.and_not(st.alive).bits();
+        for i in 0..F::WIDTH {
+            if ended >> i & 1 != 0 {
+                let l = T::to_rgb(chan_lane(&st.l, i), &st.lam[i]);
+                film.add(st.pixel.lane(i), l);
+            }
+        }
+    }
+}
