@@ -160,7 +160,7 @@ fn sample_generation(c: &mut Criterion) {
     g.finish();
 }
 
-fn cornell(size: u32, spp: u32) -> prism::systems::RenderScene {
+fn cornell(size: u32, spp: u32) -> prism::scene::RenderScene {
     let path = std::path::Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.ron");
     let o = vec![
         ("render.width".to_string(), size.to_string()),
@@ -200,7 +200,7 @@ fn load3<F: Float>(a: &[[f32; 4096]; 3], i: usize) -> prism::simd::V3<F> {
 /// Closest hits of SoA rays, a packet per `F::WIDTH` rays: the packet kd walk, or each lane's
 /// own single-ray walk.
 struct Closest<'a> {
-    scene: &'a prism::systems::RenderScene,
+    scene: &'a prism::scene::RenderScene,
     o: &'a [[f32; 4096]; 3],
     d: &'a [[f32; 4096]; 3],
     packet: bool,

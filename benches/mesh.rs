@@ -190,7 +190,7 @@ fn throughput(c: &mut Criterion) {
 /// once with prism's watertight test.
 fn versus_obvhs(
     c: &mut Criterion,
-    scene: &prism::systems::RenderScene,
+    scene: &prism::scene::RenderScene,
     primary: &[Ray],
     bounce: &[Ray],
 ) {

@@ -6,7 +6,8 @@ use prism::geometry::{Aabb, Ray};
 use prism::integrator::{Ctx, RenderOptions, generate::camera_rays as lane_camera_rays, render};
 use prism::kdtree::{KdParams, KdTree};
 use prism::sampling::{Sampler, SamplerKind, square_to_uniform_sphere};
-use prism::systems::{RenderScene, prepare};
+use prism::scene::RenderScene;
+use prism::systems::prepare;
 use std::hint::black_box;
 use std::path::Path;
 
@@ -161,7 +162,7 @@ fn integrator(c: &mut Criterion) {
 /// One wavefront pass per effect set, forced on the Cornell box, so a regression in one
 /// effect's cost shows on its own.
 fn effects(c: &mut Criterion) {
-    use prism::systems::Effect;
+    use prism::scene::Effect;
     let mut g = c.benchmark_group("effects");
     g.sample_size(10);
     let opts = wavefront(2);
@@ -187,7 +188,7 @@ fn effects(c: &mut Criterion) {
 /// Spectral transport (4 hero wavelengths) against RGB on the non-dispersive Cornell box with
 /// SPECTRAL forced on: the price of carrying wavelengths where no effect needs them.
 fn spectral(c: &mut Criterion) {
-    use prism::systems::Effect;
+    use prism::scene::Effect;
     let mut g = c.benchmark_group("spectral");
     g.sample_size(10);
     let opts = wavefront(4);

@@ -18,6 +18,7 @@ pub mod kdtree;
 pub mod medium;
 pub mod report;
 pub mod sampling;
+pub mod scene;
 pub mod scene_file;
 pub mod simd;
 pub mod spectrum;

@@ -4,7 +4,7 @@
 mod common;
 use assert_cmd::cargo::CommandCargoExt;
 use common::render::{run, scene_file};
-use prism::systems::Effect;
+use prism::scene::Effect;
 use std::path::Path;
 use std::process::Command;
 

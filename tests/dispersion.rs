@@ -10,7 +10,7 @@ use std::path::Path;
 /// image of that wavelength's radiance): the renderer's own camera, shading and transport,
 /// only the wavelength sample fixed. The film receives radiance L as the colour L·v with
 /// v = rgb(λ); the projection on v recovers L.
-fn monochromatic(scene: &prism::systems::RenderScene, lambda: f32) -> Vec<f32> {
+fn monochromatic(scene: &prism::scene::RenderScene, lambda: f32) -> Vec<f32> {
     let mut opts = RenderOptions::new(scene.settings.spp, prism::simd::Lanes::auto());
     opts.monochromatic = Some(lambda);
     let img = render(scene, &opts, &|_| {}).image();

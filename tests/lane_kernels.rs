@@ -10,8 +10,8 @@ use prism::integrator::Ctx;
 use prism::integrator::generate::camera_rays;
 use prism::sampling::warp::{self, lanes as lw};
 use prism::sampling::{Sampler, SamplerKind};
+use prism::scene::{Effect, RenderScene};
 use prism::simd::{self, Float, LaneKernel, Lanes, UInt, V3};
-use prism::systems::{Effect, RenderScene};
 use std::path::Path;
 
 #[path = "common/splitmix.rs"]

@@ -3,7 +3,7 @@
 mod common;
 use common::render::{image, run, scene, scene_file};
 use prism::film::Image;
-use prism::systems::Effect;
+use prism::scene::Effect;
 use std::path::Path;
 
 /// Intensity-weighted centroid and second moments of channel 1 (pixel-centre coordinates).

@@ -7,8 +7,8 @@
 mod common;
 
 use prism::integrator::{RenderOptions, RenderOutput, render};
+use prism::scene::RenderScene;
 use prism::simd::Lanes;
-use prism::systems::RenderScene;
 use std::path::Path;
 
 fn run(scene: &RenderScene, lanes: Lanes) -> RenderOutput {

@@ -5,7 +5,7 @@
 mod common;
 use common::render::{run, scene};
 use prism::film::Image;
-use prism::systems::Effect;
+use prism::scene::Effect;
 
 fn render(text: &str, spectral: bool) -> Image {
     let mut s = scene(text);

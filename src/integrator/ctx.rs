@@ -3,8 +3,8 @@
 
 use super::transport::SpectralData;
 use crate::sampling::{self, Sampler};
+use crate::scene::RenderScene;
 use crate::scene_file::schema::{Fresnel, LightSampling};
-use crate::systems::RenderScene;
 
 // Sample dimensions. The layout is fixed whatever the effect set, so an absent effect never
 // shifts the dimensions of the others: a scene renders the same image with or without code
@@ -72,8 +72,8 @@ impl<'a> Ctx<'a> {
             nee: s.light_sampling == LightSampling::Nee && !scene.lights.is_empty(),
             schlick: s.fresnel == Fresnel::Schlick,
             lens,
-            textures: scene.effects.has(crate::systems::Effect::Textures),
-            normal_maps: scene.effects.has(crate::systems::Effect::NormalMaps),
+            textures: scene.effects.has(crate::scene::Effect::Textures),
+            normal_maps: scene.effects.has(crate::scene::Effect::NormalMaps),
             equiangular: s.equiangular,
             box_filter: s.filter == crate::scene_file::schema::Filter::Box,
             spectral: &NO_SPECTRAL_DATA,

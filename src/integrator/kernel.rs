@@ -19,8 +19,8 @@ use super::transport::{ChannelArray, Transport};
 use super::{RenderStats, emission, generate, material, media, surface};
 use crate::film::{Tile, TileFilm};
 use crate::geometry::offset_ray_origin_lanes;
+use crate::scene::primitives::NO_MEDIUM;
 use crate::simd::{Float, Mask, UInt, V3};
-use crate::systems::primitives::NO_MEDIUM;
 
 /// Renders samples `s0..s1` of every pixel of `tile` with packets of `F::WIDTH` paths, adding
 /// each finished path's radiance to `film`.

@@ -8,8 +8,8 @@ use super::shadow;
 use super::state::{C, M, Paths, ScratchC, U, gdot, power_heuristic};
 use super::surface::Surface;
 use super::transport::{ChannelArray, Transport};
+use crate::scene::light_lanes::LaneLightSample;
 use crate::simd::{Float, Mask, UInt};
-use crate::systems::light_lanes::LaneLightSample;
 
 /// Next-event estimation at the diffuse lanes `dm`: a light sample per lane, its BSDF value
 /// and MIS weight over lanes, then a shadow ray per lane whose contribution is not zero.

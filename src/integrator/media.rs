@@ -16,11 +16,11 @@ use super::transport::{ChannelArray, MediumOps, Transport};
 use super::{RenderStats, roulette, shadow};
 use crate::geometry::{Ray, offset_ray_origin, offset_ray_origin_lanes};
 use crate::medium::{Equiangular, lanes};
+use crate::scene::lights::{EquiangularTarget, LightSource};
+use crate::scene::packet::PacketHit;
+use crate::scene::primitives::NO_MEDIUM;
 use crate::simd::{Float, Mask, UInt, V3};
 use crate::spectrum::Channels;
-use crate::systems::lights::{EquiangularTarget, LightSource};
-use crate::systems::packet::PacketHit;
-use crate::systems::primitives::NO_MEDIUM;
 use glam::Vec3;
 
 /// Dimension `k` of a segment's block.

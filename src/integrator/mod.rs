@@ -8,7 +8,7 @@
 //! | stage | file | what it does |
 //! |---|---|---|
 //! | generate | `generate.rs` | camera rays for the tile's next samples, in the lanes whose paths ended |
-//! | intersect | `crate::systems::packet` | closest hits: the kd-tree walked once per packet |
+//! | intersect | `crate::scene::packet` | closest hits: the kd-tree walked once per packet |
 //! | media | `media.rs` | MEDIA: free flight, scattering in a medium, equiangular sampling |
 //! | surface | `surface.rs` | the winning hit's surface, textures, material class |
 //! | emission | `emission.rs` | the environment on escape, emitters hit by chance |
@@ -43,8 +43,8 @@ pub mod transport;
 pub use ctx::Ctx;
 
 use crate::film::{Film, Tile, TileFilm, tiles};
+use crate::scene::{Effect, RenderScene};
 use crate::simd::Lanes;
-use crate::systems::{Effect, RenderScene};
 use rayon::prelude::*;
 use std::marker::PhantomData;
 use std::time::Instant;
@@ -239,7 +239,7 @@ fn render_with<
                 );
                 st.samples += film.samples;
                 st.dropped += film.dropped;
-                st.revolution += crate::systems::primitives::take_revolution_stats();
+                st.revolution += crate::scene::primitives::take_revolution_stats();
                 progress(tile.pixels() as u64 * n as u64);
                 (film, st)
             })

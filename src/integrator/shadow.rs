@@ -7,10 +7,10 @@ use super::state::{C, M, Paths, ScratchC, gdot, select_c};
 use super::transport::{ChannelArray, MediumOps, Transport};
 use crate::geometry::{Ray, offset_ray_origin_lanes};
 use crate::medium::lanes;
+use crate::scene::light_lanes::LaneLightSample;
+use crate::scene::primitives::NO_MEDIUM;
 use crate::simd::{Float, Mask, V3};
 use crate::spectrum::Channels;
-use crate::systems::light_lanes::LaneLightSample;
-use crate::systems::primitives::NO_MEDIUM;
 
 /// The shadow rays of light samples taken at surface points `p` (normals `nf` on the side the
 /// paths are on): towards the sampled point of an area light (offset at both ends, so

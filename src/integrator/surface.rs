@@ -7,10 +7,10 @@ use super::state::{C, M, MAX_W, Paths, Scratch3, ScratchC, U, mask_from_bits, po
 use super::transport::{ChannelArray, Transport};
 use crate::components::Material;
 use crate::geometry::Ray;
+use crate::scene::Hit;
+use crate::scene::packet::PacketHit;
+use crate::scene::primitives::emitted;
 use crate::simd::{Float, Mask, UInt, V3};
-use crate::systems::Hit;
-use crate::systems::packet::PacketHit;
-use crate::systems::primitives::emitted;
 use glam::Vec3;
 
 /// Per-lane material classes after the surface stage.

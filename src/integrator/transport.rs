@@ -10,17 +10,13 @@
 
 use super::ctx::Ctx;
 use crate::medium::{DistanceSample, HomogeneousMedium, lanes};
+use crate::scene::lights::{LightSample, LightSource};
+use crate::scene::{LightKind, RenderScene};
 use crate::spectrum::{
     Channels, EmitterSpectrum, IorModel, RgbIlluminant, RgbSigmoid, RgbUnbounded, SampledSpectrum,
     Wavelengths,
 };
-use crate::systems::lights::{LightSample, LightSource};
-use crate::systems::{LightKind, RenderScene};
 use glam::{Vec2, Vec3};
-
-/// Wavelength at which RGB transport evaluates a dispersive IOR: the helium d line, where
-/// glass catalogues quote n_d.
-pub const LAMBDA_D: f32 = 587.56;
 
 /// A homogeneous medium with coefficients in the transport's channels.
 ///
@@ -372,7 +368,7 @@ impl Transport for Rgb {
     fn eta(ior: &IorModel, _: &mut (), _: &mut Vec3) -> f32 {
         match *ior {
             IorModel::Constant(n) => n,
-            ref m => m.eta(LAMBDA_D),
+            ref m => m.eta(crate::spectrum::LAMBDA_D),
         }
     }
     #[inline]

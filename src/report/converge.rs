@@ -4,8 +4,9 @@
 use crate::film::{self, Image, ImageMeta, PngOptions};
 use crate::integrator::{RenderOptions, render};
 use crate::kdtree::KdParams;
+use crate::scene::Effect;
 use crate::scene_file::{self, LoadedScene};
-use crate::systems::{self, Effect};
+use crate::systems;
 use std::fmt::Write as _;
 use std::path::{Path, PathBuf};
 use std::time::Instant;

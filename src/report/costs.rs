@@ -3,13 +3,14 @@
 
 use crate::integrator::{RenderOptions, render};
 use crate::kdtree::KdParams;
+use crate::scene::Effect;
 use crate::scene_file;
-use crate::systems::{self, Effect};
+use crate::systems;
 use std::fmt::Write as _;
 use std::path::PathBuf;
 
 /// Median of `runs` timings of a render, in nanoseconds per sample.
-fn ns_per_sample(rs: &systems::RenderScene, spp: u32, runs: usize) -> f64 {
+fn ns_per_sample(rs: &crate::scene::RenderScene, spp: u32, runs: usize) -> f64 {
     let opts = RenderOptions {
         sample_offset: 0,
         spp,

@@ -34,6 +34,9 @@ pub const LAMBDA_MIN: f32 = 360.0;
 pub const LAMBDA_MAX: f32 = 830.0;
 /// Wavelengths per path.
 pub const N_LAMBDA: usize = 4;
+/// Wavelength at which RGB transport evaluates a dispersive IOR: the helium d line, where
+/// glass catalogues quote n_d.
+pub const LAMBDA_D: f32 = 587.56;
 
 /// A spectral distribution that can be evaluated at any wavelength (nm).
 pub trait Spectrum {

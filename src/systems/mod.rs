@@ -1,46 +1,19 @@
-//! Systems: plain functions over `&World` that turn the scene into the flat arrays the
-//! integrator reads. The acceleration structure and light list live beside the world.
+//! Systems: plain functions over `&World` that build the render-time scene
+//! ([`crate::scene::RenderScene`]): the effects manifest, the flat primitive arrays, the
+//! kd-tree and the light list, which live beside the world.
 
 pub mod effects;
-pub mod light_lanes;
 pub mod lights;
-pub mod packet;
 pub mod primitives;
 
-pub use effects::{Effect, Effects, detect_effects};
-pub use lights::{LightKind, LightSample, Lights, gather_lights};
-pub use primitives::{Hit, PrimKind, Primitives, gather_primitives};
+pub use effects::detect_effects;
+pub use lights::gather_lights;
+pub use primitives::gather_primitives;
 
-use crate::components::Camera;
-use crate::components::camera::{CameraFrame, CameraPath};
-use crate::geometry::{Aabb, Ray};
+use crate::geometry::Aabb;
 use crate::kdtree::{KdParams, KdTree};
-use crate::scene_file::{LoadedScene, RenderSettings};
-use glam::Vec3;
-
-/// Everything a render reads, built once per frame from the world.
-pub struct RenderScene {
-    pub prims: Primitives,
-    pub accel: KdTree,
-    pub lights: Lights,
-    /// The camera at the start of the frame's shutter; what every ray uses unless the camera
-    /// moves within the shutter.
-    pub camera: CameraFrame,
-    /// The camera at rest and its path, for cameras that move within the shutter.
-    pub base_camera: Camera,
-    pub camera_path: Option<CameraPath>,
-    pub camera_moves: bool,
-    /// The medium around the camera (`primitives::NO_MEDIUM` for none).
-    pub camera_medium: u32,
-    pub frame: u32,
-    /// Shutter interval of this frame in scene time (frames): [frame + open, frame + close].
-    pub shutter: (f32, f32),
-    pub environment: Vec3,
-    pub environment_spectrum: crate::spectrum::EmitterSpectrum,
-    pub effects: Effects,
-    pub settings: RenderSettings,
-    pub accel_seconds: f64,
-}
+use crate::scene::{Primitives, RenderScene};
+use crate::scene_file::LoadedScene;
 
 /// Builds the acceleration structure over the gathered primitives.
 pub fn build_accel(prims: &Primitives, params: &KdParams) -> KdTree {
@@ -133,94 +106,5 @@ impl RenderScene {
             self.accel = build_accel(&self.prims, params);
             self.accel_seconds = t0.elapsed().as_secs_f64();
         }
-    }
-
-    /// Closest hit along `ray` before `t_max`, at `time` when MOTION is on.
-    #[inline]
-    pub fn intersect<const MOTION: bool>(&self, ray: &Ray, t_max: f32, time: f32) -> Option<Hit> {
-        let mut best = None;
-        self.accel.closest_hit(ray, t_max, |prim, t_max| {
-            let (t, u, v, sub) = self
-                .prims
-                .intersect_sub_at::<MOTION>(prim, ray, t_max, time)?;
-            best = Some(Hit { t, prim, sub, u, v });
-            Some(t)
-        })?;
-        best
-    }
-
-    /// Transmittance along a shadow ray that starts in `medium`: medium boundaries are crossed
-    /// (ordered traversal, Beer–Lambert per segment), any other surface blocks it.
-    pub fn transmittance<const MOTION: bool>(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        time: f32,
-        medium: u32,
-    ) -> Vec3 {
-        self.transmittance_with::<MOTION, Vec3>(ray, t_max, time, medium, |m, d| {
-            self.prims.media[m as usize].transmittance(d)
-        })
-    }
-
-    /// [`Self::transmittance`] in any channels: `medium_tr(m, d)` is medium `m`'s
-    /// transmittance over distance `d`. Always inlined, for the same reason as the medium's
-    /// estimators (`integrator::transport::MediumOps`).
-    #[inline(always)]
-    pub fn transmittance_with<const MOTION: bool, S: crate::spectrum::Channels>(
-        &self,
-        ray: &Ray,
-        t_max: f32,
-        time: f32,
-        mut medium: u32,
-        medium_tr: impl Fn(u32, f32) -> S,
-    ) -> S {
-        let len = ray.d.length();
-        let mut r = *ray;
-        let mut t_left = t_max;
-        let mut tr = S::ONE;
-        // A ray crosses each boundary once per pass through it; nesting deeper than this
-        // would be a loop from rounding, and the light is treated as blocked.
-        for _ in 0..64 {
-            let seg = |m: u32, t: f32| {
-                if m == primitives::NO_MEDIUM {
-                    S::ONE
-                } else {
-                    medium_tr(m, t * len)
-                }
-            };
-            let Some(hit) = self.intersect::<MOTION>(&r, t_left, time) else {
-                return tr * seg(medium, t_left);
-            };
-            let m = self.prims.materials[self.prims.material[hit.prim as usize] as usize];
-            if !matches!(m, crate::components::Material::Boundary) {
-                return S::ZERO;
-            }
-            tr *= seg(medium, hit.t);
-            if tr == S::ZERO {
-                return tr;
-            }
-            let sp = self.prims.surface_at::<MOTION>(&r, &hit, time);
-            medium = self.prims.medium_after_crossing(hit.prim, sp.front, medium);
-            // Continue from just past the boundary; the direction keeps its length, so the
-            // parameter left shrinks by what was travelled.
-            let o = crate::geometry::offset_ray_origin(sp.p, -sp.facing());
-            t_left -= ((o - r.o).dot(r.d) / (len * len)).max(0.0);
-            r = Ray::new(o, r.d);
-            if t_left <= 0.0 {
-                return tr;
-            }
-        }
-        S::ZERO
-    }
-
-    /// Whether anything blocks `ray` before `t_max`, at `time` when MOTION is on.
-    #[inline]
-    pub fn occluded<const MOTION: bool>(&self, ray: &Ray, t_max: f32, time: f32) -> bool {
-        self.accel.any_hit(ray, t_max, |prim, t_max| {
-            self.prims
-                .intersect_at::<MOTION>(prim, ray, t_max, time)
-                .is_some()
-        })
     }
 }

@@ -3,8 +3,9 @@
 use prism::film::Image;
 use prism::integrator::{RenderOptions, RenderOutput, render};
 use prism::kdtree::KdParams;
+use prism::scene::RenderScene;
 use prism::scene_file::load_str;
-use prism::systems::{RenderScene, prepare};
+use prism::systems::prepare;
 use std::path::Path;
 
 /// Parses scene text (as if it lived in `scenes/`) and runs the systems.
