@@ -39,6 +39,9 @@ pub struct Ctx<'a> {
     pub textures: bool,
     pub normal_maps: bool,
     pub equiangular: bool,
+    /// Whether any primitive is a pure medium boundary: the only surface a shadow ray may
+    /// pass through (MEDIA).
+    pub boundaries: bool,
     /// A box pixel filter instead of the tent.
     pub box_filter: bool,
     /// Spectral forms of the scene's colours (empty in RGB transport).
@@ -75,6 +78,11 @@ impl<'a> Ctx<'a> {
             textures: scene.effects.has(crate::scene::Effect::Textures),
             normal_maps: scene.effects.has(crate::scene::Effect::NormalMaps),
             equiangular: s.equiangular,
+            boundaries: scene
+                .prims
+                .materials
+                .iter()
+                .any(|m| matches!(m, crate::components::Material::Boundary)),
             box_filter: s.filter == crate::scene_file::schema::Filter::Box,
             spectral: &NO_SPECTRAL_DATA,
             single_wavelength: s.wavelengths == 1,

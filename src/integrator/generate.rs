@@ -2,11 +2,12 @@
 
 use super::bsdf::LaneChannels;
 use super::ctx::{Ctx, DIM_FILM, DIM_LENS, DIM_TIME};
-use super::state::{C, MAX_W, Paths, ScratchC, U, mask_from_bits, select_c};
+use super::state::{C, M, MAX_W, Paths, ScratchC, U, mask_from_bits, select_c};
 use super::transport::{ChannelArray, Transport};
 use crate::components::camera::CameraFrame;
 use crate::film::Tile;
 use crate::sampling::warp::lanes as warp;
+use crate::scene::primitives::NO_MEDIUM;
 use crate::simd::{Float, Mask, UInt, V3, math};
 use glam::Vec2;
 
@@ -200,6 +201,8 @@ pub(super) fn refill<
         return;
     }
     let fm = mask_from_bits::<F>(fresh);
+    let cam_in = M::<F>::splat(ctx.scene.camera_medium != NO_MEDIUM);
+    st.in_medium = st.in_medium.and_not(fm) | (fm & cam_in);
     let (xl, yl, il) = (
         U::<F>::from_fn(|i| x[i]),
         U::<F>::from_fn(|i| y[i]),

@@ -59,6 +59,7 @@ pub fn render_tile<
         sample: U::<F>::splat(0),
         alive: M::<F>::splat(false),
         medium: [NO_MEDIUM; MAX_W],
+        in_medium: M::<F>::splat(false),
         segments: [0; MAX_W],
     };
     let scene = ctx.scene;
@@ -94,14 +95,7 @@ pub fn render_tile<
         if MEDIA && boundary.any() {
             // Carry on in the same direction, in the medium beyond.
             st.o = V3::select(boundary, offset_ray_origin_lanes(sf.p, -sf.nf), st.o);
-            let bits = boundary.bits();
-            let prims = &scene.prims;
-            for i in 0..F::WIDTH {
-                if bits >> i & 1 != 0 {
-                    st.medium[i] =
-                        prims.medium_after_crossing(sf.prim[i], sf.front.lane(i), st.medium[i]);
-                }
-            }
+            media::cross(ctx, &mut st, &sf, boundary);
         }
         // Finished paths go to the film.
         let ended = started.and_not(st.alive).bits();

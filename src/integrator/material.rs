@@ -7,7 +7,7 @@ use super::ctx::{Ctx, DIM_BOUNCE, DIMS_PER_BOUNCE};
 use super::state::{C, M, MAX_W, Paths, ScratchC, U, chan_lane, gdot, gnormalize, select_c};
 use super::surface::{CLASS_DIELECTRIC, CLASS_DIFFUSE, CLASS_MIRROR, Surface};
 use super::transport::{ChannelArray, Transport};
-use super::{RenderStats, light, roulette};
+use super::{RenderStats, light, media, roulette};
 use crate::components::Material;
 use crate::geometry::offset_ray_origin_lanes;
 use crate::simd::{Float, Mask, UInt, V3};
@@ -117,14 +117,7 @@ pub(super) fn scatter<
         let o = V3::select(t, down, up);
         let d = V3::select(t, below(wi, sf.nf), reflect_above(wi, sf.nf));
         if MEDIA {
-            let bits = t.bits();
-            let prims = &ctx.scene.prims;
-            for i in 0..F::WIDTH {
-                if bits >> i & 1 != 0 {
-                    st.medium[i] =
-                        prims.medium_after_crossing(sf.prim[i], sf.front.lane(i), st.medium[i]);
-                }
-            }
+            media::cross(ctx, st, sf, t);
         }
         st.o = V3::select(em, o, st.o);
         st.d = V3::select(em, d, st.d);

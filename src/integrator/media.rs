@@ -12,6 +12,7 @@ use super::state::{
     M, MAX_W, Paths, Scratch3, ScratchC, U, chan_lane, finite, gdot, mask_from_bits,
     power_heuristic, select_c,
 };
+use super::surface::Surface;
 use super::transport::{ChannelArray, MediumOps, Transport};
 use super::{RenderStats, roulette, shadow};
 use crate::geometry::{Ray, offset_ray_origin, offset_ray_origin_lanes};
@@ -22,6 +23,27 @@ use crate::scene::primitives::NO_MEDIUM;
 use crate::simd::{Float, Mask, UInt, V3};
 use crate::spectrum::Channels;
 use glam::Vec3;
+
+/// The lanes in `m` cross the surface they hit, a medium's boundary or a dielectric's
+/// interface: each takes the medium beyond it.
+#[inline(always)]
+pub(super) fn cross<F: Float, T: Transport, const N: usize>(
+    ctx: &Ctx,
+    st: &mut Paths<F, T, N>,
+    sf: &Surface<F, N>,
+    m: M<F>,
+) {
+    let prims = &ctx.scene.prims;
+    let bits = m.bits();
+    let mut inside = 0u32;
+    for i in 0..F::WIDTH {
+        if bits >> i & 1 != 0 {
+            st.medium[i] = prims.medium_after_crossing(sf.prim[i], sf.front.lane(i), st.medium[i]);
+            inside |= u32::from(st.medium[i] != NO_MEDIUM) << i;
+        }
+    }
+    st.in_medium = st.in_medium.and_not(m) | mask_from_bits::<F>(inside);
+}
 
 /// Dimension `k` of a segment's block.
 #[inline(always)]
@@ -45,11 +67,7 @@ pub(super) fn free_flight<
     started: M<F>,
     stats: &mut RenderStats,
 ) -> M<F> {
-    let mut inside = 0u32;
-    for i in 0..F::WIDTH {
-        inside |= u32::from(st.medium[i] != NO_MEDIUM) << i;
-    }
-    let inm = started & mask_from_bits::<F>(inside);
+    let inm = started & st.in_medium;
     if inm.none() {
         return inm;
     }

@@ -2,15 +2,14 @@
 //! with MEDIA they carry the transmittance of the media they cross.
 
 use super::RenderStats;
+use super::bsdf::{Chan, LaneChannels};
 use super::ctx::Ctx;
 use super::state::{C, M, Paths, ScratchC, gdot, select_c};
 use super::transport::{ChannelArray, MediumOps, Transport};
 use crate::geometry::{Ray, offset_ray_origin_lanes};
 use crate::medium::lanes;
 use crate::scene::light_lanes::LaneLightSample;
-use crate::scene::primitives::NO_MEDIUM;
 use crate::simd::{Float, Mask, V3};
-use crate::spectrum::Channels;
 
 /// The shadow rays of light samples taken at surface points `p` (normals `nf` on the side the
 /// paths are on): towards the sampled point of an area light (offset at both ends, so
@@ -101,45 +100,44 @@ fn through_media<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize, con
     let scene = ctx.scene;
     let blocked = scene.occluded_packet::<F, MOTION>(o, d, shoot, t_max, st.time);
     let clear = shoot.and_not(blocked);
-    let mut tr = ScratchC::<N>::new();
     // Clear lanes inside a medium take its transmittance over the whole length; those outside
     // any transmit everything, and without such lanes no exponential is evaluated at all.
-    let bits = clear.bits();
-    let mut inside = 0u32;
-    let mut sigma_t = ScratchC::<N>::new();
-    for i in 0..F::WIDTH {
-        if bits >> i & 1 != 0 && st.medium[i] != NO_MEDIUM {
-            inside |= 1 << i;
-            sigma_t.set(i, T::medium(ctx, st.medium[i], &st.lam[i]).sigma_t());
+    let inside = clear & st.in_medium;
+    let mut tr = C::<F, N>::splat(F::one());
+    if inside.any() {
+        let mut sigma_t = ScratchC::<N>::new();
+        let bits = inside.bits();
+        for i in 0..F::WIDTH {
+            if bits >> i & 1 != 0 {
+                sigma_t.set(i, T::medium(ctx, st.medium[i], &st.lam[i]).sigma_t());
+            }
         }
-    }
-    if inside != 0 {
         let len = gdot(d, d).sqrt();
         let t: [F; N] = lanes::transmittance(&sigma_t.load::<F>().0, t_max * len);
-        for (k, c) in t.iter().enumerate() {
-            c.store(&mut tr.0[k]);
-        }
+        tr = select_c(inside, Chan(t), tr);
     }
-    let outside = bits & !inside;
-    for i in 0..F::WIDTH {
-        if outside >> i & 1 != 0 {
-            tr.set(i, T::S::ONE);
+    // Only a medium's boundary lets a shadow ray through what it meets: in a scene without
+    // boundaries a blocked ray is blocked, and no lane walks its ray again.
+    let mut reach = clear;
+    if ctx.boundaries && blocked.any() {
+        let mut through = ScratchC::<N>::new();
+        let bits = blocked.bits();
+        for i in 0..F::WIDTH {
+            if bits >> i & 1 != 0 {
+                let lam = &st.lam[i];
+                let t: T::S = scene.transmittance_with::<MOTION, T::S>(
+                    &Ray::new(o.lane(i), d.lane(i)),
+                    t_max.lane(i),
+                    st.time.lane(i),
+                    st.medium[i],
+                    #[inline(always)]
+                    |m, d| T::medium(ctx, m, lam).transmittance(d),
+                );
+                through.set(i, t);
+            }
         }
+        tr = select_c(blocked, through.load(), tr);
+        reach = shoot;
     }
-    let bits = blocked.bits();
-    for i in 0..F::WIDTH {
-        if bits >> i & 1 != 0 {
-            let lam = &st.lam[i];
-            let t: T::S = scene.transmittance_with::<MOTION, T::S>(
-                &Ray::new(o.lane(i), d.lane(i)),
-                t_max.lane(i),
-                st.time.lane(i),
-                st.medium[i],
-                #[inline(always)]
-                |m, d| T::medium(ctx, m, lam).transmittance(d),
-            );
-            tr.set(i, t);
-        }
-    }
-    st.l = select_c(shoot, st.l + contrib * tr.load(), st.l);
+    st.l = select_c(reach, st.l + contrib * tr, st.l);
 }

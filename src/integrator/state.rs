@@ -35,6 +35,8 @@ pub(super) struct Paths<F: Float, T: Transport, const N: usize> {
     pub(super) alive: M<F>,
     /// MEDIA: each lane's medium and the medium segments its path has sampled so far.
     pub(super) medium: [u32; MAX_W],
+    /// MEDIA: the lanes whose medium is not `NO_MEDIUM`.
+    pub(super) in_medium: M<F>,
     pub(super) segments: [u32; MAX_W],
 }
 
