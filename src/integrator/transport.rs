@@ -174,7 +174,7 @@ impl EmitSpec {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn eval(&self, lam: &Wavelengths) -> SampledSpectrum {
         match self {
             EmitSpec::Zero => SampledSpectrum::ZERO,
@@ -311,7 +311,7 @@ pub trait Transport: Copy + Send + Sync + 'static {
     fn reflectance(ctx: &Ctx, mat: u32, rgb: Vec3, textured: bool, lam: &Self::Lambda) -> Self::S;
     /// Radiance `le` (RGB, already texture-modulated by `tex`) of emitter material `mat`.
     fn emission(ctx: &Ctx, mat: u32, le: Vec3, tex: Option<Vec3>, lam: &Self::Lambda) -> Self::S;
-    #[inline]
+    #[inline(always)]
     fn light_radiance(ctx: &Ctx, ls: &LightSample, lam: &Self::Lambda) -> Self::S {
         Self::source_radiance(ctx, &ls.source, ls.radiance, lam)
     }
@@ -338,44 +338,44 @@ impl Transport for Rgb {
     type Lambda = ();
     type Med = HomogeneousMedium;
 
-    #[inline]
+    #[inline(always)]
     fn wavelengths(_: &Ctx, _: u32, _: u32) {}
-    #[inline]
+    #[inline(always)]
     fn initial_beta(_: &()) -> Vec3 {
         Vec3::ONE
     }
-    #[inline]
+    #[inline(always)]
     fn reflectance(_: &Ctx, _: u32, rgb: Vec3, _: bool, _: &()) -> Vec3 {
         rgb
     }
-    #[inline]
+    #[inline(always)]
     fn emission(_: &Ctx, _: u32, le: Vec3, _: Option<Vec3>, _: &()) -> Vec3 {
         le
     }
-    #[inline]
+    #[inline(always)]
     fn source_radiance(_: &Ctx, _: &LightSource, rgb: Vec3, _: &()) -> Vec3 {
         rgb
     }
-    #[inline]
+    #[inline(always)]
     fn point_radiance(_: &Ctx, _: u32, rgb: Vec3, scale: f32, _: &()) -> Vec3 {
         rgb * scale
     }
-    #[inline]
+    #[inline(always)]
     fn environment(ctx: &Ctx, _: &()) -> Vec3 {
         ctx.scene.environment
     }
-    #[inline]
+    #[inline(always)]
     fn eta(ior: &IorModel, _: &mut (), _: &mut Vec3) -> f32 {
         match *ior {
             IorModel::Constant(n) => n,
             ref m => m.eta(crate::spectrum::LAMBDA_D),
         }
     }
-    #[inline]
+    #[inline(always)]
     fn medium(ctx: &Ctx, m: u32, _: &()) -> HomogeneousMedium {
         ctx.scene.prims.media[m as usize]
     }
-    #[inline]
+    #[inline(always)]
     fn to_rgb(l: Vec3, _: &()) -> Vec3 {
         l
     }
@@ -385,7 +385,7 @@ impl Transport for Rgb {
 #[derive(Clone, Copy, Debug)]
 pub struct Spectral;
 
-#[inline]
+#[inline(always)]
 fn sigmoid4(s: &RgbSigmoid, lam: &Wavelengths) -> SampledSpectrum {
     SampledSpectrum(s.eval4(lam.lambda))
 }
@@ -396,7 +396,7 @@ impl Transport for Spectral {
     type Lambda = Wavelengths;
     type Med = SpectralMedium;
 
-    #[inline]
+    #[inline(always)]
     fn wavelengths(ctx: &Ctx, pixel: u32, index: u32) -> Wavelengths {
         if let Some(lambda) = ctx.monochromatic {
             return Wavelengths {
@@ -411,11 +411,11 @@ impl Transport for Spectral {
         }
         lam
     }
-    #[inline]
+    #[inline(always)]
     fn initial_beta(lam: &Wavelengths) -> SampledSpectrum {
         SampledSpectrum(lam.pdf.map(|p| if p > 0.0 { 1.0 } else { 0.0 }))
     }
-    #[inline]
+    #[inline(always)]
     fn reflectance(
         ctx: &Ctx,
         mat: u32,
@@ -429,7 +429,7 @@ impl Transport for Spectral {
             sigmoid4(&ctx.spectral.refl[mat as usize], lam)
         }
     }
-    #[inline]
+    #[inline(always)]
     fn emission(
         ctx: &Ctx,
         mat: u32,
@@ -447,7 +447,7 @@ impl Transport for Spectral {
             (Some(t), s) => s.eval(lam) * sigmoid4(&RgbSigmoid::from_rgb(t), lam),
         }
     }
-    #[inline]
+    #[inline(always)]
     fn source_radiance(
         ctx: &Ctx,
         source: &LightSource,
@@ -462,7 +462,7 @@ impl Transport for Spectral {
             LightSource::Environment => Self::environment(ctx, lam),
         }
     }
-    #[inline]
+    #[inline(always)]
     fn point_radiance(
         ctx: &Ctx,
         light: u32,
@@ -472,13 +472,13 @@ impl Transport for Spectral {
     ) -> SampledSpectrum {
         ctx.spectral.point[light as usize].eval(lam) * scale
     }
-    #[inline]
+    #[inline(always)]
     fn environment(ctx: &Ctx, lam: &Wavelengths) -> SampledSpectrum {
         ctx.spectral
             .environment
             .map_or(SampledSpectrum::ZERO, |e| e.eval(lam))
     }
-    #[inline]
+    #[inline(always)]
     fn eta(ior: &IorModel, lam: &mut Wavelengths, beta: &mut SampledSpectrum) -> f32 {
         match *ior {
             IorModel::Constant(n) => n,
@@ -494,7 +494,7 @@ impl Transport for Spectral {
             }
         }
     }
-    #[inline]
+    #[inline(always)]
     fn medium(ctx: &Ctx, m: u32, lam: &Wavelengths) -> SpectralMedium {
         let (a, s, g) = &ctx.spectral.media[m as usize];
         let sigma_a = SampledSpectrum(a.eval4(lam.lambda));
@@ -505,7 +505,7 @@ impl Transport for Spectral {
             g: *g,
         }
     }
-    #[inline]
+    #[inline(always)]
     fn to_rgb(l: SampledSpectrum, lam: &Wavelengths) -> Vec3 {
         crate::spectrum::xyz_to_linear_srgb(crate::spectrum::to_xyz(&l, lam))
     }

@@ -84,7 +84,7 @@ static D65_F32: [f32; CIE_D65.len()] = {
 
 /// CIE 1931 2° colour matching functions (x̄, ȳ, z̄) at `lambda` nm,
 /// linear between the 1 nm entries; zero outside 360–830 nm.
-#[inline]
+#[inline(always)]
 pub fn cie_xyz(lambda: f32) -> Vec3 {
     let x = lambda - CMF_FIRST_NM as f32;
     if !(x >= 0.0 && x <= (CMF_ROWS - 1) as f32) {
@@ -101,7 +101,7 @@ pub fn cie_xyz(lambda: f32) -> Vec3 {
 
 /// CIE standard illuminant D65, relative spectral power (100 at 560 nm),
 /// linear between the 5 nm table entries; zero outside 300–830 nm.
-#[inline]
+#[inline(always)]
 pub fn d65(lambda: f32) -> f32 {
     let x = (lambda - D65_FIRST_NM as f32) * (1.0 / D65_STEP_NM as f32);
     if !(x >= 0.0 && x <= (D65_F32.len() - 1) as f32) {
@@ -118,6 +118,7 @@ pub fn d65(lambda: f32) -> f32 {
 /// Terminated wavelengths (pdf 0) contribute nothing; see
 /// [`Wavelengths::terminate_secondary`] for why the sum still divides by N.
 /// Dividing by the ȳ integral makes a constant spectrum of 1 give Y = 1.
+#[inline(always)]
 pub fn to_xyz(l: &SampledSpectrum, w: &Wavelengths) -> Vec3 {
     let mut xyz = Vec3::ZERO;
     for i in 0..N_LAMBDA {
@@ -194,6 +195,7 @@ pub const XYZ_TO_SRGB: Mat3 = Mat3::from_cols(
 );
 
 /// CIE XYZ → linear sRGB (D65 white: XYZ (0.9505, 1, 1.089) → (1, 1, 1)).
+#[inline(always)]
 pub fn xyz_to_linear_srgb(xyz: Vec3) -> Vec3 {
     XYZ_TO_SRGB * xyz
 }

@@ -70,6 +70,7 @@ impl Blackbody {
     }
 
     /// Scaled spectral radiance at `lambda` nm.
+    #[inline(always)]
     pub fn eval(&self, lambda: f32) -> f32 {
         (self.norm * planck_f64(f64::from(lambda), self.kelvin)) as f32
     }
@@ -125,6 +126,7 @@ impl Illuminant {
     }
 
     /// Scaled spectral power at `lambda` nm.
+    #[inline(always)]
     pub fn eval(&self, lambda: f32) -> f32 {
         match self.which {
             NamedIlluminant::D65 => self.d65_norm * d65(lambda),

@@ -23,6 +23,7 @@ impl IorModel {
     /// real index (n² ≤ 0, inside an absorption resonance, far outside any
     /// published range) it returns 1, so a bad model cannot divide by zero
     /// downstream.
+    #[inline(always)]
     pub fn eta(&self, lambda_nm: f32) -> f32 {
         let um = f64::from(lambda_nm) * 1e-3;
         let l2 = um * um;

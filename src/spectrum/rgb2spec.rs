@@ -127,6 +127,7 @@ impl RgbSigmoid {
     }
 
     /// Reflectance at `lambda` nm.
+    #[inline(always)]
     pub fn eval(&self, lambda: f32) -> f32 {
         let t = (lambda - T_CENTRE) / T_HALF;
         self.scale * sigmoid((self.c[0] * t + self.c[1]) * t + self.c[2])
@@ -134,7 +135,7 @@ impl RgbSigmoid {
 
     /// Reflectance at four wavelengths at once (the path's), as [`RgbSigmoid::eval`] in
     /// 4-wide arithmetic: one polynomial, one square root and one division per call.
-    #[inline]
+    #[inline(always)]
     pub fn eval4(&self, lambda: [f32; 4]) -> [f32; 4] {
         use glam::Vec4;
         let t = (Vec4::from_array(lambda) - Vec4::splat(T_CENTRE)) / T_HALF;
@@ -262,12 +263,13 @@ impl RgbIlluminant {
     }
 
     /// Spectral radiance at `lambda` nm.
+    #[inline(always)]
     pub fn eval(&self, lambda: f32) -> f32 {
         self.0.eval(lambda) * d65(lambda) / D65_LUMINANCE
     }
 
     /// [`RgbIlluminant::eval`] at four wavelengths.
-    #[inline]
+    #[inline(always)]
     pub fn eval4(&self, lambda: [f32; 4]) -> [f32; 4] {
         let s = self.0.eval4(lambda);
         let illuminant = Self::illuminant4(lambda);
@@ -277,7 +279,7 @@ impl RgbIlluminant {
     /// The illuminant every RGB emitter is a multiple of (D65 of luminance 1) at four
     /// wavelengths, from a 1 nm table over the visible range (D65 is linear between its 5 nm
     /// entries, so the finer table interpolates to the same function).
-    #[inline]
+    #[inline(always)]
     pub fn illuminant4(lambda: [f32; 4]) -> [f32; 4] {
         lambda.map(|l| {
             let x = l - LAMBDA_MIN;
@@ -325,13 +327,13 @@ impl RgbUnbounded {
     }
 
     /// Value at `lambda` nm.
-    #[inline]
+    #[inline(always)]
     pub fn eval(&self, lambda: f32) -> f32 {
         self.scale * self.shape.eval(lambda)
     }
 
     /// [`RgbUnbounded::eval`] at four wavelengths.
-    #[inline]
+    #[inline(always)]
     pub fn eval4(&self, lambda: [f32; 4]) -> [f32; 4] {
         self.shape.eval4(lambda).map(|v| v * self.scale)
     }

@@ -42,6 +42,7 @@ impl Wavelengths {
     /// wavelength distributed by the same importance pdf, so each `pdf[i]`
     /// is simply `visible_pdf(lambda[i])`, and the four are stratified in
     /// CDF space as hero sampling intends.
+    #[inline(always)]
     pub fn sample_visible(u: f32) -> Self {
         let u = if u.is_finite() {
             u.clamp(0.0, 1.0)
@@ -109,6 +110,7 @@ impl Wavelengths {
     /// times: the result is the unbiased single-wavelength estimate
     /// L(λ₀)·cmf(λ₀)/p(λ₀) instead of a quarter of it (pbrt-v4's
     /// `TerminateSecondary`). Calling it again does nothing.
+    #[inline(always)]
     pub fn terminate_secondary(&mut self) {
         if self.secondary_terminated() {
             return;
@@ -129,7 +131,7 @@ impl Wavelengths {
 /// exponent and mantissa m ∈ [√½, √2): ln m = 2·artanh(s), s = (m − 1)/(m + 1), |s| ≤ 0.172,
 /// whose odd series to s⁹ leaves a relative error below 4·10⁻¹⁰, far under f32's ulp. Lanes
 /// are independent and branch-free, so the loop vectorises.
-#[inline]
+#[inline(always)]
 fn atanh4(t: [f32; N_LAMBDA]) -> [f32; N_LAMBDA] {
     let mut out = [0.0; N_LAMBDA];
     for i in 0..N_LAMBDA {
@@ -148,6 +150,7 @@ fn atanh4(t: [f32; N_LAMBDA]) -> [f32; N_LAMBDA] {
 }
 
 /// Inverse CDF of the visible-wavelength pdf: `u` ∈ [0, 1] → λ in nm.
+#[inline(always)]
 pub fn sample_visible_wavelength(u: f32) -> f32 {
     let t = VIS_T0 + u * (VIS_T1 - VIS_T0);
     (VIS_MU + t.atanh() / VIS_A).clamp(LAMBDA_MIN, LAMBDA_MAX)
