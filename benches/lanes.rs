@@ -112,7 +112,7 @@ impl LaneKernel for Generate<'_> {
         for i in (0..self.out.len()).step_by(F::WIDTH) {
             let k = F::U32::from_fn(|l| (i + l) as u32);
             // Sixteen samples of each pixel along a row: neighbouring lanes share pixels and
-            // differ in sample index, as in the packet kernel.
+            // differ in sample index, as in the kernel.
             let (x, y, index) = (k.shri::<4>(), F::U32::splat(7), k & F::U32::splat(15));
             let r = if self.rays {
                 let c =
@@ -238,7 +238,7 @@ impl LaneKernel for Closest<'_> {
 }
 
 /// The kd-tree walked as a packet against one ray at a time per lane, on coherent camera
-/// rays (four samples of each pixel, pixels along rows, as the packet kernel orders them) and
+/// rays (four samples of each pixel, pixels along rows, as the kernel orders them) and
 /// on incoherent diffuse-like rays (random points and directions inside the box).
 fn kd_packet(c: &mut Criterion) {
     use prism::sampling::{Sampler, SamplerKind, square_to_uniform_sphere};

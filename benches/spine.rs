@@ -37,7 +37,7 @@ fn scene_text(text: &str, path: &Path, w: u32, h: u32) -> RenderScene {
 }
 
 /// Render options for `spp` samples per pixel at the widest native width.
-fn wavefront(spp: u32) -> RenderOptions {
+fn opts(spp: u32) -> RenderOptions {
     RenderOptions::new(spp, prism::simd::Lanes::auto())
 }
 
@@ -151,7 +151,7 @@ fn integrator(c: &mut Criterion) {
     );
     for (name, t) in [("motion_blur", &text), ("motion_blur_static", &still)] {
         let scene = scene_text(t, Path::new("scenes/motion_blur.ron"), 64, 36);
-        let opts = wavefront(4);
+        let opts = opts(4);
         g.bench_function(format!("{name}_64x36_4spp"), |b| {
             b.iter(|| render(&scene, &opts, &|_| {}).stats.samples)
         });
@@ -159,13 +159,13 @@ fn integrator(c: &mut Criterion) {
     g.finish();
 }
 
-/// One wavefront pass per effect set, forced on the Cornell box, so a regression in one
+/// One pass per effect set, forced on the Cornell box, so a regression in one
 /// effect's cost shows on its own.
 fn effects(c: &mut Criterion) {
     use prism::scene::Effect;
     let mut g = c.benchmark_group("effects");
     g.sample_size(10);
-    let opts = wavefront(2);
+    let opts = opts(2);
     let sets: [(&str, &[Effect]); 5] = [
         ("none", &[]),
         ("lens", &[Effect::Lens]),
@@ -191,7 +191,7 @@ fn spectral(c: &mut Criterion) {
     use prism::scene::Effect;
     let mut g = c.benchmark_group("spectral");
     g.sample_size(10);
-    let opts = wavefront(4);
+    let opts = opts(4);
     for (name, force) in [("rgb", false), ("spectral_4", true)] {
         let mut scene = cornell(64, 4);
         if force {
@@ -252,7 +252,7 @@ fn textures(c: &mut Criterion) {
         );
     for (name, t) in [("textured", &text), ("untextured", &plain)] {
         let scene = scene_text(t, &dir.join("scenes/textures.ron"), 64, 48);
-        let opts = wavefront(4);
+        let opts = opts(4);
         g.bench_function(format!("pass_{name}_64x48_4spp"), |b| {
             b.iter(|| render(&scene, &opts, &|_| {}).stats.samples)
         });
@@ -271,7 +271,7 @@ fn media(c: &mut Criterion) {
         "entities: [\n        (name: \"fog\", shape: Box(min: (-1.0, -1.0, -1.0), max: (557.0, 550.0, 560.0)),\n         medium: (sigma_a: Rgb(0.0002, 0.0002, 0.0002), sigma_s: Rgb(0.001, 0.001, 0.001), g: 0.3)),",
         1,
     );
-    let opts = wavefront(2);
+    let opts = opts(2);
     for (name, t) in [("clear", &text), ("thin_fog", &fog)] {
         let scene = scene_text(t, &dir.join("scenes/cornell.ron"), 48, 48);
         g.bench_function(format!("cornell_48x48_2spp_{name}"), |b| {

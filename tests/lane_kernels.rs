@@ -486,7 +486,7 @@ impl LaneKernel for OffsetKernel<'_> {
     }
 }
 
-/// The packet kernel spawns rays with the lane form of the robust offset: the same bits as the
+/// The kernel spawns rays with the lane form of the robust offset: the same bits as the
 /// scalar one, at every magnitude (near the origin, where the absolute offset takes over; at
 /// ±0; at huge coordinates; on either side of zero).
 #[test]

@@ -55,7 +55,7 @@ fn every_width_renders_every_shipped_scene_alike() {
         assert_eq!(base.lanes.width(), 1);
         for &lanes in &widths {
             let out = run(&scene, lanes);
-            // Every effect variant runs in the packet kernel at the width asked for.
+            // Every effect variant runs at the width asked for.
             assert_eq!(out.lanes, lanes, "{name}");
             compared += 1;
             let img = out.image();

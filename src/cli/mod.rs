@@ -533,15 +533,11 @@ fn print_stats(rs: &RenderScene, out: &integrator::RenderOutput, output: &Path, 
         sps / threads as f64
     );
     eprintln!("dropped samples: {}", s.dropped);
-    if s.lane_slots > 0 {
-        eprintln!(
-            "simd: width {}, mean lane occupancy {:.3}",
-            out.lanes.describe(),
-            s.rays as f64 / s.lane_slots as f64
-        );
-    } else {
-        eprintln!("simd: width {}", out.lanes.describe());
-    }
+    eprintln!(
+        "simd: width {}, mean lane occupancy {:.3}",
+        out.lanes.describe(),
+        s.rays as f64 / s.lane_slots.max(1) as f64
+    );
     eprintln!(
         "rays: {} closest-hit, {} shadow ({:.2} Mrays/s)",
         s.rays,

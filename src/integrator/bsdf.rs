@@ -40,7 +40,7 @@ pub mod lobe {
     pub const SPECULAR: u32 = SPECULAR_REFLECTION | SPECULAR_TRANSMISSION;
 }
 
-/// Colour channels over lanes: what BSDF weights are made of. The scalar integrator's channel
+/// Colour channels over lanes: what BSDF weights are made of. The transports' scalar channel
 /// types (`Vec3` for RGB, `SampledSpectrum` for four wavelengths) are the width-1 forms.
 pub trait LaneChannels<F: Float>:
     Copy + Mul<Output = Self> + Mul<F, Output = Self> + Add<Output = Self>

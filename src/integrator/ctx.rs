@@ -39,8 +39,8 @@ pub struct Ctx<'a> {
     pub textures: bool,
     pub normal_maps: bool,
     pub equiangular: bool,
-    /// Whether any primitive is a pure medium boundary: the only surface a shadow ray may
-    /// pass through (MEDIA).
+    /// Whether the scene has a pure medium boundary material (an entity with a medium and no
+    /// material): the only surface a shadow ray may pass through (MEDIA).
     pub boundaries: bool,
     /// A box pixel filter instead of the tent.
     pub box_filter: bool,

@@ -8,7 +8,7 @@
 //!    |________________________________ film ←___________________________________________|
 //! ```
 //!
-//! Width 1 is this same code over `f32`: the reference integrator, the oracle every wider
+//! Width 1 is this same code over `f32`: the reference, the oracle every wider
 //! packet is tested against (`tests/simd_widths.rs`).
 
 use super::bsdf::LaneChannels;
@@ -75,12 +75,12 @@ pub fn render_tile<
         let hits = scene.intersect_packet::<F, MOTION>(st.o, st.d, st.alive, st.time);
         // MEDIA: lanes in a medium first sample their flight; those that scatter there are
         // done with this vertex, the rest reach their hit.
-        let in_medium = if MEDIA {
+        let scattered_in_medium = if MEDIA {
             media::free_flight::<F, T, N, MOTION>(ctx, &mut st, &hits, started, stats)
         } else {
             M::<F>::splat(false)
         };
-        let at = st.alive.and_not(in_medium);
+        let at = st.alive.and_not(scattered_in_medium);
         let sf = surface::surfaces::<F, T, N, MOTION, MEDIA>(ctx, &st, &hits, at);
         // Misses see the environment; emitters add their radiance and absorb the rest.
         emission::escaped::<F, T, N>(ctx, &mut st, at.and_not(sf.hit));
@@ -88,7 +88,7 @@ pub fn render_tile<
         let boundary = sf.hit & sf.class.eq(U::<F>::splat(CLASS_BOUNDARY));
         let scatters = !sf.class.eq(U::<F>::splat(CLASS_NONE)) & !boundary;
         let surface = sf.hit & scatters & st.depth.lt(max_depth);
-        st.alive = (st.alive & in_medium) | surface | boundary;
+        st.alive = (st.alive & scattered_in_medium) | surface | boundary;
         if surface.any() {
             material::scatter::<F, T, N, MOTION, MEDIA>(ctx, &mut st, &sf, surface, stats);
         }

@@ -18,7 +18,7 @@
 //! | roulette | `roulette.rs` | Russian roulette |
 //! | film | `crate::film::tile` | finished paths into the tile's film |
 //!
-//! [`state::Paths`] declares the state of a path once; [`ctx::Ctx`] holds what no stage
+//! `state::Paths` declares the state of a path once; [`ctx::Ctx`] holds what no stage
 //! changes; [`bsdf`] the BSDFs over lanes; [`transport`] what a path carries (RGB or four hero
 //! wavelengths) and how the scene's colours enter it.
 //!
@@ -86,7 +86,7 @@ pub struct RenderOptions {
     pub lanes: Lanes,
     /// Every path carries this one wavelength (nm) and the film receives its radiance as that
     /// wavelength's colour: a monochromatic render, for studies of dispersion. Spectral
-    /// transport only; `None` renders normally.
+    /// transport only (RGB transport ignores it); `None` renders normally.
     pub monochromatic: Option<f32>,
 }
 

@@ -21,7 +21,7 @@ pub(super) fn from_surface<F: Float>(
     nf: V3<F>,
     ls: &LaneLightSample<F>,
 ) -> (V3<F>, V3<F>, F) {
-    // Area lights: `spawn_ray_to`.
+    // Area lights: `geometry::spawn_ray_to` over lanes.
     let d = ls.q - p;
     let n = V3::select(gdot(nf, d).ge(F::zero()), nf, -nf);
     let o_area = offset_ray_origin_lanes(p, n);
@@ -77,10 +77,11 @@ pub(super) fn trace<
     st.l = select_c(lit, st.l + contrib, st.l);
 }
 
-/// MEDIA: shadow rays of the lanes in `shoot`, from their current medium: a packet any-hit first;
-/// a ray that meets nothing stays in that medium and takes its transmittance over the
-/// whole length, one that meets something may cross boundaries and takes
-/// `transmittance_with` per lane. Adds `contrib` times the transmittance to the radiance.
+/// MEDIA: shadow rays of the lanes in `shoot`, from their current medium: a packet any-hit
+/// first; a ray that meets nothing stays in that medium and takes its transmittance over the
+/// whole length. One that meets something is blocked, unless the scene has pure medium
+/// boundaries: then it walks its ray again per lane (`transmittance_with`), crossing them.
+/// Adds `contrib` times the transmittance to the radiance of the lanes reached.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 fn through_media<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(

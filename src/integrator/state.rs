@@ -103,7 +103,7 @@ impl Scratch3 {
 }
 
 /// glam's `Vec3::dot` over lanes: unfused, in the same order, so the decisions the scalar
-/// integrator takes on glam's dot products come out the same.
+/// code (e.g. `Lights::sample`) takes on glam's dot products come out the same.
 #[inline(always)]
 pub(super) fn gdot<F: Float>(a: V3<F>, b: V3<F>) -> F {
     a.x * b.x + a.y * b.y + a.z * b.z

@@ -9,14 +9,14 @@
 //! converting the accumulated XYZ).
 
 use super::ctx::Ctx;
-use crate::medium::{DistanceSample, HomogeneousMedium, lanes};
+use crate::medium::{HomogeneousMedium, lanes};
 use crate::scene::lights::{LightSample, LightSource};
 use crate::scene::{LightKind, RenderScene};
 use crate::spectrum::{
     Channels, EmitterSpectrum, IorModel, RgbIlluminant, RgbSigmoid, RgbUnbounded, SampledSpectrum,
     Wavelengths,
 };
-use glam::{Vec2, Vec3};
+use glam::Vec3;
 
 /// A homogeneous medium with coefficients in the transport's channels.
 ///
@@ -31,31 +31,8 @@ pub trait MediumOps<S>: Copy {
     /// Henyey–Greenstein asymmetry.
     fn g(&self) -> f32;
     fn transmittance(&self, d: f32) -> S;
-    fn sample_distance(&self, t_max: f32, u_c: f32, u: f32, probs: S) -> DistanceSample<S>;
     fn distance_pdf(&self, t: f32, probs: S) -> f32;
     fn phase(&self, wo: Vec3, wi: Vec3) -> f32;
-    fn sample_phase(&self, wo: Vec3, u: Vec2) -> (Vec3, f32);
-}
-
-/// The lane free flight at width 1, as the scalar integrator's [`DistanceSample`].
-#[inline(always)]
-fn free_flight<const N: usize>(
-    sigma_s: [f32; N],
-    sigma_t: [f32; N],
-    t_max: f32,
-    u_c: f32,
-    u: f32,
-    probs: [f32; N],
-) -> DistanceSample<[f32; N]> {
-    let f = lanes::sample_free_flight::<f32, N>(&sigma_s, &sigma_t, t_max, u_c, u, &probs);
-    if f.scatter {
-        DistanceSample::Scatter {
-            t: f.t,
-            weight: f.weight,
-        }
-    } else {
-        DistanceSample::Pass { weight: f.weight }
-    }
 }
 
 impl MediumOps<Vec3> for HomogeneousMedium {
@@ -79,29 +56,12 @@ impl MediumOps<Vec3> for HomogeneousMedium {
         ))
     }
     #[inline(always)]
-    fn sample_distance(&self, t_max: f32, u_c: f32, u: f32, probs: Vec3) -> DistanceSample {
-        free_flight(
-            self.sigma_s.to_array(),
-            self.sigma_t().to_array(),
-            t_max,
-            u_c,
-            u,
-            probs.to_array(),
-        )
-        .map(Vec3::from_array)
-    }
-    #[inline(always)]
     fn distance_pdf(&self, t: f32, probs: Vec3) -> f32 {
         lanes::free_flight_pdf::<f32, 3>(&self.sigma_t().to_array(), t, &probs.to_array())
     }
     #[inline(always)]
     fn phase(&self, wo: Vec3, wi: Vec3) -> f32 {
         lanes::hg_phase_dirs::<f32>(wo.into(), wi.into(), self.g)
-    }
-    #[inline(always)]
-    fn sample_phase(&self, wo: Vec3, u: Vec2) -> (Vec3, f32) {
-        let (wi, pdf) = lanes::sample_hg::<f32>(wo.into(), self.g, u.x, u.y);
-        (wi.into(), pdf)
     }
 }
 
@@ -131,27 +91,12 @@ impl MediumOps<SampledSpectrum> for SpectralMedium {
         SampledSpectrum(lanes::transmittance::<f32, 4>(&self.sigma_t.0, d))
     }
     #[inline(always)]
-    fn sample_distance(
-        &self,
-        t_max: f32,
-        u_c: f32,
-        u: f32,
-        probs: SampledSpectrum,
-    ) -> DistanceSample<SampledSpectrum> {
-        free_flight(self.sigma_s.0, self.sigma_t.0, t_max, u_c, u, probs.0).map(SampledSpectrum)
-    }
-    #[inline(always)]
     fn distance_pdf(&self, t: f32, probs: SampledSpectrum) -> f32 {
         lanes::free_flight_pdf::<f32, 4>(&self.sigma_t.0, t, &probs.0)
     }
     #[inline(always)]
     fn phase(&self, wo: Vec3, wi: Vec3) -> f32 {
         lanes::hg_phase_dirs::<f32>(wo.into(), wi.into(), self.g)
-    }
-    #[inline(always)]
-    fn sample_phase(&self, wo: Vec3, u: Vec2) -> (Vec3, f32) {
-        let (wi, pdf) = lanes::sample_hg::<f32>(wo.into(), self.g, u.x, u.y);
-        (wi.into(), pdf)
     }
 }
 

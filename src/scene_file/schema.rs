@@ -42,7 +42,7 @@ pub struct Render {
     /// The pixel filter camera samples are drawn from.
     #[serde(default)]
     pub filter: Filter,
-    /// The lane width of the packet kernel: `"auto"`, 16, 8 or 1 (`--simd` overrides it).
+    /// The lane width of the kernel: `"auto"`, 16, 8 or 1 (`--simd` overrides it).
     #[serde(default)]
     pub simd: crate::simd::SimdChoice,
     /// Overrides every surface of revolution's Newton tolerance (for accuracy studies).
