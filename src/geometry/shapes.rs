@@ -165,7 +165,7 @@ impl Sphere {
         (F::select(first, t0, t1), hit, outside)
     }
 
-    #[inline]
+    #[inline(always)]
     pub fn surface(&self, ray: &Ray, t: f32, front: bool) -> SurfacePoint {
         let rel = ray.at(t) - self.center;
         let n = rel.normalize_or(Vec3::Y);
@@ -327,7 +327,7 @@ impl Planar {
         (self.w.dot(rel.cross(self.v)), self.w.dot(self.u.cross(rel)))
     }
 
-    #[inline]
+    #[inline(always)]
     pub fn surface(&self, ray: &Ray, a: f32, b: f32) -> SurfacePoint {
         SurfacePoint {
             p: self.center + a * self.u + b * self.v,
@@ -411,7 +411,7 @@ impl OrientedBox {
         b.padded(PAD_REL * 4.0, 0.0)
     }
 
-    #[inline]
+    #[inline(always)]
     fn object_ray(&self, ray: &Ray) -> Ray {
         Ray::new(
             self.to_object.transform_point3(ray.o),
@@ -511,6 +511,7 @@ impl OrientedBox {
     }
 
     /// The face nearest to object-space point `p`: (axis, plane coordinate, sign).
+    #[inline(always)]
     fn face(&self, p: Vec3) -> (usize, f32, f32) {
         let size = (self.max - self.min).max(Vec3::splat(f32::MIN_POSITIVE));
         let mut best = (f32::INFINITY, 0usize, 0.0f32, 1.0f32);
@@ -527,6 +528,7 @@ impl OrientedBox {
         (best.1, best.2, best.3)
     }
 
+    #[inline(always)]
     pub fn surface(&self, ray: &Ray, t: f32, front: bool) -> SurfacePoint {
         let r = self.object_ray(ray);
         let mut p = r.at(t);
