@@ -1,9 +1,10 @@
 //! Dispersion: Snell's law per wavelength, and where `scenes/prism.ron` puts each colour.
 
 use glam::Vec3;
-use prism::integrator::transport::{Spectral, Transport};
 use prism::integrator::{RenderOptions, render};
-use prism::spectrum::{IorModel, IorPreset, SampledSpectrum, Wavelengths};
+use prism::spectrum::{
+    IorModel, IorPreset, SampledSpectrum, Wavelengths, to_xyz, xyz_to_linear_srgb,
+};
 use std::path::Path;
 
 /// Renders `scene` with every path carrying the single wavelength `lambda` (a monochromatic
@@ -18,7 +19,7 @@ fn monochromatic(scene: &prism::scene::RenderScene, lambda: f32) -> Vec<f32> {
         lambda: [lambda; 4],
         pdf: [1.0, 0.0, 0.0, 0.0],
     };
-    let v = Spectral::to_rgb(SampledSpectrum([1.0, 0.0, 0.0, 0.0]), &lam);
+    let v = xyz_to_linear_srgb(to_xyz(&SampledSpectrum([1.0, 0.0, 0.0, 0.0]), &lam));
     assert!(v.length_squared() > 0.0);
     img.pixels
         .iter()

@@ -721,3 +721,72 @@ fn no_unsafe_outside_the_lane_module() {
     let lib = std::fs::read_to_string(root.join("src/lib.rs")).unwrap();
     assert!(lib.contains("#![deny(unsafe_code)]"));
 }
+
+/// Gathers read `table[idx]` in every lane at every width (the native forms use the
+/// hardware gather), and an index past the end panics rather than reading out of bounds.
+struct Gather<'a> {
+    table: &'a [f32],
+    idx: &'a [u32],
+}
+
+impl LaneKernel for Gather<'_> {
+    type Output = Vec<f32>;
+    #[inline(always)]
+    fn run<F: Float>(self) -> Vec<f32> {
+        let mut out = Vec::new();
+        for chunk in self.idx.chunks_exact(F::WIDTH) {
+            let i = F::U32::from_fn(|l| chunk[l]);
+            let g = F::gather(self.table, i);
+            out.extend((0..F::WIDTH).map(|l| g.lane(l)));
+        }
+        out
+    }
+}
+
+#[test]
+fn gathers_read_the_table_and_refuse_indices_past_its_end() {
+    let table: Vec<f32> = (0..1000).map(|i| (i as f32).sqrt() - 7.0).collect();
+    let mut rng = SplitMix(99);
+    let idx: Vec<u32> = (0..16 * 500)
+        .map(|k| match k % 5 {
+            0 => 0,
+            1 => 999,
+            _ => (rng.next() % 1000) as u32,
+        })
+        .collect();
+    for lanes in forms() {
+        let got = simd::dispatch(
+            lanes,
+            Gather {
+                table: &table,
+                idx: &idx,
+            },
+        );
+        for (g, &i) in got.iter().zip(&idx) {
+            assert_eq!(
+                g.to_bits(),
+                table[i as usize].to_bits(),
+                "{}",
+                lanes.describe()
+            );
+        }
+        for bad in [1000u32, u32::MAX, 1 << 31] {
+            let mut idx = vec![3u32; 16];
+            idx[lanes.width() - 1] = bad;
+            let r = std::panic::catch_unwind(|| {
+                simd::dispatch(
+                    lanes,
+                    Gather {
+                        table: &table,
+                        idx: &idx,
+                    },
+                )
+            });
+            assert!(
+                r.is_err(),
+                "{}: index {bad} read past the table",
+                lanes.describe()
+            );
+        }
+    }
+}

@@ -3,7 +3,7 @@
 
 use super::bsdf::Chan;
 use super::ctx::Ctx;
-use super::state::{M, Paths, ScratchC, U, power_heuristic, select_c};
+use super::state::{M, Paths, U, power_heuristic, select_c};
 use super::surface::Surface;
 use super::transport::{ChannelArray, Transport};
 use crate::simd::{Float, Mask, UInt};
@@ -28,14 +28,14 @@ pub(super) fn escaped<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize
         power_heuristic(st.prev_pdf, F::splat(scene.lights.pdf_environment())),
     );
     let e = if T::SPECTRAL {
-        let mut e = ScratchC::<N>::new();
+        let mut e = T::colours();
         let bits = miss.bits();
         for i in 0..F::WIDTH {
             if bits >> i & 1 != 0 {
-                e.set(i, T::environment(ctx, &st.lam[i]));
+                T::set_environment(&mut e, i, ctx, &st.lam);
             }
         }
-        e.load()
+        T::eval(&e, &st.lam)
     } else {
         // RGB: N = 3.
         let e = [env.x, env.y, env.z];

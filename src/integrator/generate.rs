@@ -2,7 +2,7 @@
 
 use super::bsdf::LaneChannels;
 use super::ctx::{Ctx, DIM_FILM, DIM_LENS, DIM_TIME};
-use super::state::{C, M, MAX_W, Paths, ScratchC, U, mask_from_bits, select_c};
+use super::state::{C, M, MAX_W, Paths, U, mask_from_bits, select_c};
 use super::transport::{ChannelArray, Transport};
 use crate::components::camera::CameraFrame;
 use crate::film::Tile;
@@ -179,7 +179,6 @@ pub(super) fn refill<
     let mut y = [0u32; MAX_W];
     let mut idx = [0u32; MAX_W];
     let mut fresh = 0u32;
-    let mut beta0 = ScratchC::<N>::new();
     let alive = st.alive.bits();
     for i in 0..F::WIDTH {
         if alive >> i & 1 == 0 && *next < total {
@@ -190,11 +189,6 @@ pub(super) fn refill<
             *next += 1;
             st.medium[i] = ctx.scene.camera_medium;
             st.segments[i] = 0;
-            if T::SPECTRAL {
-                let lam = T::wavelengths(ctx, y[i] * ctx.width + x[i], idx[i]);
-                beta0.set(i, T::initial_beta(&lam));
-                st.lam[i] = lam;
-            }
         }
     }
     if fresh == 0 {
@@ -212,19 +206,16 @@ pub(super) fn refill<
     st.o = V3::select(fm, cam.o, st.o);
     st.d = V3::select(fm, cam.d, st.d);
     st.time = F::select(fm, cam.time, st.time);
-    let beta0 = if T::SPECTRAL {
-        beta0.load()
-    } else {
-        C::<F, N>::splat(F::one())
-    };
-    st.beta = select_c(fm, beta0, st.beta);
+    let pixel = yl.wrapping_mul(U::<F>::splat(ctx.width)).wrapping_add(xl);
+    let lam = T::wavelengths::<F>(ctx, pixel, il);
+    st.beta = select_c(fm, T::initial_beta(&lam), st.beta);
+    st.lam = T::select_lanes(fm, lam, st.lam);
     st.l = select_c(fm, C::<F, N>::splat(F::zero()), st.l);
     st.eta_scale = F::select(fm, F::one(), st.eta_scale);
     st.depth = U::<F>::select(fm, U::<F>::splat(0), st.depth);
     st.specular = st.specular.and_not(fm);
     st.prev_pdf = F::select(fm, F::zero(), st.prev_pdf);
     st.prev_p = V3::select(fm, cam.o, st.prev_p);
-    let pixel = yl.wrapping_mul(U::<F>::splat(ctx.width)).wrapping_add(xl);
     st.pixel = U::<F>::select(fm, pixel, st.pixel);
     st.sample = U::<F>::select(fm, il, st.sample);
     st.alive |= fm;

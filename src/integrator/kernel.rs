@@ -13,7 +13,7 @@
 
 use super::bsdf::LaneChannels;
 use super::ctx::Ctx;
-use super::state::{C, M, MAX_W, Paths, U, chan_lane};
+use super::state::{C, M, MAX_W, Paths, U};
 use super::surface::{CLASS_BOUNDARY, CLASS_NONE};
 use super::transport::{ChannelArray, Transport};
 use super::{RenderStats, emission, generate, material, media, surface};
@@ -48,7 +48,7 @@ pub fn render_tile<
         d: zero3,
         beta: C::<F, N>::splat(F::zero()),
         l: C::<F, N>::splat(F::zero()),
-        lam: [T::Lambda::default(); MAX_W],
+        lam: T::no_lanes(),
         eta_scale: F::one(),
         depth: U::<F>::splat(0),
         specular: M::<F>::splat(false),
@@ -99,10 +99,12 @@ pub fn render_tile<
         }
         // Finished paths go to the film.
         let ended = started.and_not(st.alive).bits();
-        for i in 0..F::WIDTH {
-            if ended >> i & 1 != 0 {
-                let l = T::to_rgb(chan_lane(&st.l, i), &st.lam[i]);
-                film.add(st.pixel.lane(i), l);
+        if ended != 0 {
+            let rgb = T::to_rgb(&st.l, &st.lam);
+            for i in 0..F::WIDTH {
+                if ended >> i & 1 != 0 {
+                    film.add(st.pixel.lane(i), rgb.lane(i));
+                }
             }
         }
     }

@@ -5,7 +5,7 @@ use super::RenderStats;
 use super::bsdf::{Chan, Diffuse, Frame};
 use super::ctx::Ctx;
 use super::shadow;
-use super::state::{C, M, Paths, ScratchC, U, gdot, power_heuristic};
+use super::state::{C, M, Paths, U, gdot, power_heuristic};
 use super::surface::Surface;
 use super::transport::{ChannelArray, Transport};
 use crate::scene::light_lanes::LaneLightSample;
@@ -75,15 +75,15 @@ pub(super) fn lane_radiance<F: Float, T: Transport<S: ChannelArray<N>>, const N:
     m: M<F>,
 ) -> C<F, N> {
     if T::SPECTRAL {
-        let mut rad = ScratchC::<N>::new();
+        let mut rad = T::colours();
         let bits = m.bits();
         for i in 0..F::WIDTH {
             if bits >> i & 1 != 0 {
                 let rgb = ls.radiance.lane(i);
-                rad.set(i, T::source_radiance(ctx, &ls.sources[i], rgb, &st.lam[i]));
+                T::set_source(&mut rad, i, ctx, &ls.sources[i], rgb, &st.lam);
             }
         }
-        rad.load()
+        T::eval(&rad, &st.lam)
     } else {
         // RGB: N = 3.
         let r = [ls.radiance.x, ls.radiance.y, ls.radiance.z];

@@ -4,14 +4,13 @@
 
 use super::bsdf::{Dielectric, Diffuse, Frame, Mirror, Mode};
 use super::ctx::{Ctx, DIM_BOUNCE, DIMS_PER_BOUNCE};
-use super::state::{C, M, MAX_W, Paths, ScratchC, U, chan_lane, gdot, gnormalize, select_c};
+use super::state::{C, M, MAX_W, Paths, U, gdot, gnormalize, mask_from_bits, select_c};
 use super::surface::{CLASS_DIELECTRIC, CLASS_DIFFUSE, CLASS_MIRROR, Surface};
 use super::transport::{ChannelArray, Transport};
 use super::{RenderStats, light, media, roulette};
 use crate::components::Material;
 use crate::geometry::offset_ray_origin_lanes;
 use crate::simd::{Float, Mask, UInt, V3};
-use crate::spectrum::Channels;
 
 /// One scattering event in every lane of `live`: light samples at diffuse lanes, then a BSDF
 /// sample per material class present, then Russian roulette.
@@ -75,7 +74,7 @@ pub(super) fn scatter<
         // The IOR per lane; a dispersive one ends the lane's secondary wavelengths.
         let prims = &ctx.scene.prims;
         let mut ior = [1.0f32; MAX_W];
-        let mut beta = ScratchC::<N>::new();
+        let mut dispersive = 0u32;
         let bits = em.bits();
         for (i, n) in ior.iter_mut().enumerate().take(F::WIDTH) {
             if bits >> i & 1 != 0 {
@@ -83,20 +82,13 @@ pub(super) fn scatter<
                 else {
                     continue;
                 };
-                // RGB transport's `eta` leaves the throughput alone.
-                let mut b: T::S = if T::SPECTRAL {
-                    chan_lane(&st.beta, i)
-                } else {
-                    T::S::ONE
-                };
-                *n = T::eta(&model, &mut st.lam[i], &mut b);
-                if T::SPECTRAL {
-                    beta.set(i, b);
-                }
+                let (eta, disperses) = T::ior(&model, &st.lam, i);
+                *n = eta;
+                dispersive |= (disperses as u32) << i;
             }
         }
-        if T::SPECTRAL {
-            st.beta = select_c(em, beta.load(), st.beta);
+        if dispersive != 0 {
+            T::terminate_secondary(&mut st.lam, &mut st.beta, mask_from_bits::<F>(dispersive));
         }
         let ior = F::load(&ior);
         let eta = F::select(sf.front, ior, ior.recip());

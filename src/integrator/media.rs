@@ -78,7 +78,7 @@ pub(super) fn free_flight<
     let mut meds: [Option<T::Med>; MAX_W] = [None; MAX_W];
     for i in 0..F::WIDTH {
         if bits >> i & 1 != 0 {
-            let med = T::medium(ctx, st.medium[i], &st.lam[i]);
+            let med = T::medium(ctx, st.medium[i], &T::lane(&st.lam, i));
             sigma_s.set(i, med.sigma_s());
             sigma_t.set(i, med.sigma_t());
             g[i] = med.g();
@@ -296,7 +296,7 @@ fn equiangular_nee<
 ) -> Option<(Ray, f32, T::S)> {
     let (pixel, index) = (st.pixel.lane(i), st.sample.lane(i));
     let ray = Ray::new(st.o.lane(i), st.d.lane(i));
-    let (time, lambda) = (st.time.lane(i), &st.lam[i]);
+    let (time, lambda) = (st.time.lane(i), &T::lane(&st.lam, i));
     let beta: T::S = chan_lane(&st.beta, i);
     let lights = &ctx.scene.lights;
     let prims = &ctx.scene.prims;

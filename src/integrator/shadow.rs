@@ -110,7 +110,10 @@ fn through_media<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize, con
         let bits = inside.bits();
         for i in 0..F::WIDTH {
             if bits >> i & 1 != 0 {
-                sigma_t.set(i, T::medium(ctx, st.medium[i], &st.lam[i]).sigma_t());
+                sigma_t.set(
+                    i,
+                    T::medium(ctx, st.medium[i], &T::lane(&st.lam, i)).sigma_t(),
+                );
             }
         }
         let len = gdot(d, d).sqrt();
@@ -125,7 +128,7 @@ fn through_media<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize, con
         let bits = blocked.bits();
         for i in 0..F::WIDTH {
             if bits >> i & 1 != 0 {
-                let lam = &st.lam[i];
+                let lam = &T::lane(&st.lam, i);
                 let t: T::S = scene.transmittance_with::<MOTION, T::S>(
                     &Ray::new(o.lane(i), d.lane(i)),
                     t_max.lane(i),

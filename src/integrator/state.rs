@@ -23,7 +23,7 @@ pub(super) struct Paths<F: Float, T: Transport, const N: usize> {
     pub(super) beta: C<F, N>,
     pub(super) l: C<F, N>,
     /// Each lane's wavelengths (nothing in RGB).
-    pub(super) lam: [T::Lambda; MAX_W],
+    pub(super) lam: T::Lanes<F>,
     pub(super) eta_scale: F,
     pub(super) depth: U<F>,
     pub(super) specular: M<F>,

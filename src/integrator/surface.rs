@@ -2,8 +2,9 @@
 //! normal maps) and its material, sorted into material classes for the scattering stage;
 //! emitters hit by chance with their radiance and MIS weight.
 
+use super::bsdf::LaneChannels;
 use super::ctx::Ctx;
-use super::state::{C, M, MAX_W, Paths, Scratch3, ScratchC, U, mask_from_bits, power_heuristic};
+use super::state::{C, M, MAX_W, Paths, Scratch3, U, mask_from_bits, power_heuristic};
 use super::transport::{ChannelArray, Transport};
 use crate::components::Material;
 use crate::geometry::Ray;
@@ -93,7 +94,7 @@ pub(super) fn surfaces<
     let scene = ctx.scene;
     let prims = &scene.prims;
     let (mut p, mut n, mut ns) = (Scratch3::new(), Scratch3::new(), Scratch3::new());
-    let (mut color, mut le) = (ScratchC::<N>::new(), ScratchC::<N>::new());
+    let (mut color, mut le) = (T::colours(), T::colours());
     let mut class = [CLASS_NONE; MAX_W];
     let mut mats = [0u32; MAX_W];
     let mut prim = [0u32; MAX_W];
@@ -114,7 +115,6 @@ pub(super) fn surfaces<
         mats[i] = mat;
         prim[i] = hit.prim;
         let (sp, material, tex_albedo) = surface_material::<MOTION>(ctx, &ray, &hit, time);
-        let lam = &st.lam[i];
         p.set(i, sp.p);
         n.set(i, sp.facing());
         ns.set(i, sp.shading_facing());
@@ -122,21 +122,18 @@ pub(super) fn surfaces<
         match material {
             Material::Diffuse { albedo } => {
                 class[i] = CLASS_DIFFUSE;
-                color.set(
-                    i,
-                    T::reflectance(ctx, mat, albedo, tex_albedo.is_some(), lam),
-                );
+                T::set_reflectance(&mut color, i, ctx, mat, albedo, tex_albedo.is_some());
             }
             Material::Mirror { tint } => {
                 class[i] = CLASS_MIRROR;
-                color.set(i, T::reflectance(ctx, mat, tint, tex_albedo.is_some(), lam));
+                T::set_reflectance(&mut color, i, ctx, mat, tint, tex_albedo.is_some());
             }
             Material::Dielectric { .. } => class[i] = CLASS_DIELECTRIC,
             Material::Light { .. } => {
                 let radiance = emitted(&material, sp.n, -ray.d);
                 if radiance != Vec3::ZERO {
                     emit_bits |= 1 << i;
-                    le.set(i, T::emission(ctx, mat, radiance, tex_albedo, lam));
+                    T::set_emission(&mut le, i, ctx, mat, radiance, tex_albedo, &st.lam);
                     let (depth, specular) = (st.depth.lane(i), st.specular.lane(i));
                     le_w[i] = if depth == 0 || specular || !ctx.nee {
                         1.0
@@ -164,11 +161,15 @@ pub(super) fn surfaces<
         nsf: ns.v3(),
         front: mask_from_bits::<F>(front_bits),
         class: U::<F>::from_fn(|i| class[i]),
-        color: color.load(),
+        color: T::eval(&color, &st.lam),
         mat: mats,
         prim,
         emits: mask_from_bits::<F>(emit_bits),
-        le: le.load(),
+        le: if emit_bits != 0 {
+            T::eval(&le, &st.lam)
+        } else {
+            C::<F, N>::splat(F::zero())
+        },
         le_w: F::load(&le_w),
     }
 }

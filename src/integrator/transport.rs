@@ -8,10 +8,15 @@
 //! converted to linear sRGB (the conversion is linear, so converting each sample equals
 //! converting the accumulated XYZ).
 
+use super::bsdf::Chan;
 use super::ctx::Ctx;
+use super::state::{MAX_W, mask_from_bits};
 use crate::medium::{HomogeneousMedium, lanes};
 use crate::scene::lights::{LightSample, LightSource};
 use crate::scene::{LightKind, RenderScene};
+use crate::simd::{Float, Mask, UInt, V3};
+use crate::spectrum::N_LAMBDA;
+use crate::spectrum::lanes::{self as spectrum_lanes, LaneWavelengths};
 use crate::spectrum::{
     Channels, EmitterSpectrum, IorModel, RgbIlluminant, RgbSigmoid, RgbUnbounded, SampledSpectrum,
     Wavelengths,
@@ -240,62 +245,188 @@ impl ChannelArray<4> for SampledSpectrum {
 }
 
 /// What a path carries, and how the scene's colours become that.
+///
+/// The kernel keeps every lane's wavelengths in lanes ([`Transport::Lanes`]) and evaluates
+/// the scene's colours over lanes: a stage records each lane's colour (an RGB triple, or a
+/// spectrum's few coefficients) one lane at a time in [`Transport::Colours`], then
+/// [`Transport::eval`] computes all lanes at their wavelengths at once. The one-path forms
+/// (`Lambda`, `source_radiance`, `medium`) serve the per-lane medium estimators.
 pub trait Transport: Copy + Send + Sync + 'static {
-    /// Colours depend on the path's wavelengths (so the kernel evaluates them per lane;
-    /// RGB colours are the same for every lane).
+    /// Colours depend on the path's wavelengths.
     const SPECTRAL: bool;
     type S: Channels;
-    /// The path's wavelengths (nothing in RGB).
+    /// One path's wavelengths (nothing in RGB).
     type Lambda: Copy + std::fmt::Debug + Default + Send + Sync;
+    /// Every lane's wavelengths (nothing in RGB).
+    type Lanes<F: Float>: Copy;
+    /// Colours recorded one lane at a time, evaluated over lanes.
+    type Colours;
     type Med: MediumOps<Self::S>;
 
-    fn wavelengths(ctx: &Ctx, pixel: u32, index: u32) -> Self::Lambda;
+    fn no_lanes<F: Float>() -> Self::Lanes<F>;
+    /// The wavelengths of sample `sample` of pixel `pixel`, in every lane.
+    fn wavelengths<F: Float>(ctx: &Ctx, pixel: F::U32, sample: F::U32) -> Self::Lanes<F>;
+    fn select_lanes<F: Float>(m: F::Mask, a: Self::Lanes<F>, b: Self::Lanes<F>) -> Self::Lanes<F>;
+    /// Lane `i`'s wavelengths.
+    fn lane<F: Float>(lam: &Self::Lanes<F>, i: usize) -> Self::Lambda;
     /// Throughput of a new path: one on every live wavelength.
-    fn initial_beta(lam: &Self::Lambda) -> Self::S;
-    /// Material `mat`'s reflectance, `rgb` its (possibly texture-modulated) colour.
-    fn reflectance(ctx: &Ctx, mat: u32, rgb: Vec3, textured: bool, lam: &Self::Lambda) -> Self::S;
-    /// Radiance `le` (RGB, already texture-modulated by `tex`) of emitter material `mat`.
-    fn emission(ctx: &Ctx, mat: u32, le: Vec3, tex: Option<Vec3>, lam: &Self::Lambda) -> Self::S;
+    fn initial_beta<F: Float, const N: usize>(lam: &Self::Lanes<F>) -> Chan<F, N>;
+    /// The IOR of a dielectric at lane `i`'s hero wavelength, and whether it disperses (so
+    /// the lane must end its secondary wavelengths: [`Transport::terminate_secondary`]).
+    fn ior<F: Float>(model: &IorModel, lam: &Self::Lanes<F>, i: usize) -> (f32, bool);
+    /// Ends the secondary wavelengths (and their throughput) of the lanes in `m`.
+    fn terminate_secondary<F: Float, const N: usize>(
+        lam: &mut Self::Lanes<F>,
+        beta: &mut Chan<F, N>,
+        m: F::Mask,
+    );
+
+    fn colours() -> Self::Colours;
+    /// Lane `i`: material `mat`'s reflectance, `rgb` its (possibly texture-modulated) colour.
+    fn set_reflectance(
+        c: &mut Self::Colours,
+        i: usize,
+        ctx: &Ctx,
+        mat: u32,
+        rgb: Vec3,
+        textured: bool,
+    );
+    /// Lane `i`: radiance `le` (RGB, already texture-modulated by `tex`) of emitter `mat`.
+    #[allow(clippy::too_many_arguments)]
+    fn set_emission<F: Float>(
+        c: &mut Self::Colours,
+        i: usize,
+        ctx: &Ctx,
+        mat: u32,
+        le: Vec3,
+        tex: Option<Vec3>,
+        lam: &Self::Lanes<F>,
+    );
+    /// Lane `i`: the radiance `rgb` of a light sample from `source`.
+    fn set_source<F: Float>(
+        c: &mut Self::Colours,
+        i: usize,
+        ctx: &Ctx,
+        source: &LightSource,
+        rgb: Vec3,
+        lam: &Self::Lanes<F>,
+    );
+    /// Lane `i`: the environment's radiance.
+    fn set_environment<F: Float>(c: &mut Self::Colours, i: usize, ctx: &Ctx, lam: &Self::Lanes<F>);
+    /// The recorded colours at every lane's wavelengths (lanes never set are unspecified).
+    fn eval<F: Float, const N: usize>(c: &Self::Colours, lam: &Self::Lanes<F>) -> Chan<F, N>;
+    /// The paths' radiance as linear sRGB for the film.
+    fn to_rgb<F: Float, const N: usize>(l: &Chan<F, N>, lam: &Self::Lanes<F>) -> V3<F>;
+
     #[inline(always)]
     fn light_radiance(ctx: &Ctx, ls: &LightSample, lam: &Self::Lambda) -> Self::S {
         Self::source_radiance(ctx, &ls.source, ls.radiance, lam)
     }
-    /// The radiance `rgb` of a light sample from `source`.
+    /// One path's radiance `rgb` of a light sample from `source`.
     fn source_radiance(ctx: &Ctx, source: &LightSource, rgb: Vec3, lam: &Self::Lambda) -> Self::S;
-    /// A point light's intensity times `scale` (falloff / d²).
+    /// A point light's intensity times `scale` (falloff / d²) for one path.
     fn point_radiance(ctx: &Ctx, light: u32, rgb: Vec3, scale: f32, lam: &Self::Lambda) -> Self::S;
-    fn environment(ctx: &Ctx, lam: &Self::Lambda) -> Self::S;
-    /// The relative IOR to use at this interface; a dispersive one ends the secondary
-    /// wavelengths (and their throughput).
-    fn eta(ior: &IorModel, lam: &mut Self::Lambda, beta: &mut Self::S) -> f32;
     fn medium(ctx: &Ctx, m: u32, lam: &Self::Lambda) -> Self::Med;
-    /// The path's radiance as linear sRGB for the film.
-    fn to_rgb(l: Self::S, lam: &Self::Lambda) -> Vec3;
 }
 
 /// Three-channel linear sRGB transport.
 #[derive(Clone, Copy, Debug)]
 pub struct Rgb;
 
+/// RGB colours, one triple per lane.
+pub struct RgbColours([[f32; MAX_W]; 3]);
+
+impl RgbColours {
+    #[inline(always)]
+    fn set(&mut self, i: usize, v: Vec3) {
+        (self.0[0][i], self.0[1][i], self.0[2][i]) = (v.x, v.y, v.z);
+    }
+}
+
+/// Channels `[F; M]` as `Chan<F, N>`: the transports' channel counts are fixed (3 and 4), the
+/// kernels' `N` is theirs.
+#[inline(always)]
+fn chan<F: Float, const N: usize, const M: usize>(a: [F; M]) -> Chan<F, N> {
+    const { assert!(N == M) };
+    // A loop rather than `std::array::from_fn`, which is not always inlined.
+    let mut c = [F::zero(); N];
+    for (c, a) in c.iter_mut().zip(a) {
+        *c = a;
+    }
+    Chan(c)
+}
+
 impl Transport for Rgb {
     const SPECTRAL: bool = false;
     type S = Vec3;
     type Lambda = ();
+    type Lanes<F: Float> = ();
+    type Colours = RgbColours;
     type Med = HomogeneousMedium;
 
     #[inline(always)]
-    fn wavelengths(_: &Ctx, _: u32, _: u32) {}
+    fn no_lanes<F: Float>() {}
     #[inline(always)]
-    fn initial_beta(_: &()) -> Vec3 {
-        Vec3::ONE
+    fn wavelengths<F: Float>(_: &Ctx, _: F::U32, _: F::U32) {}
+    #[inline(always)]
+    fn select_lanes<F: Float>(_: F::Mask, _: (), _: ()) {}
+    #[inline(always)]
+    fn lane<F: Float>(_: &(), _: usize) {}
+    #[inline(always)]
+    fn initial_beta<F: Float, const N: usize>(_: &()) -> Chan<F, N> {
+        Chan([F::one(); N])
     }
     #[inline(always)]
-    fn reflectance(_: &Ctx, _: u32, rgb: Vec3, _: bool, _: &()) -> Vec3 {
-        rgb
+    fn ior<F: Float>(model: &IorModel, _: &(), _: usize) -> (f32, bool) {
+        match *model {
+            IorModel::Constant(n) => (n, false),
+            ref m => (m.eta(crate::spectrum::LAMBDA_D), false),
+        }
     }
     #[inline(always)]
-    fn emission(_: &Ctx, _: u32, le: Vec3, _: Option<Vec3>, _: &()) -> Vec3 {
-        le
+    fn terminate_secondary<F: Float, const N: usize>(_: &mut (), _: &mut Chan<F, N>, _: F::Mask) {}
+    #[inline(always)]
+    fn colours() -> RgbColours {
+        RgbColours([[0.0; MAX_W]; 3])
+    }
+    #[inline(always)]
+    fn set_reflectance(c: &mut RgbColours, i: usize, _: &Ctx, _: u32, rgb: Vec3, _: bool) {
+        c.set(i, rgb);
+    }
+    #[inline(always)]
+    fn set_emission<F: Float>(
+        c: &mut RgbColours,
+        i: usize,
+        _: &Ctx,
+        _: u32,
+        le: Vec3,
+        _: Option<Vec3>,
+        _: &(),
+    ) {
+        c.set(i, le);
+    }
+    #[inline(always)]
+    fn set_source<F: Float>(
+        c: &mut RgbColours,
+        i: usize,
+        _: &Ctx,
+        _: &LightSource,
+        rgb: Vec3,
+        _: &(),
+    ) {
+        c.set(i, rgb);
+    }
+    #[inline(always)]
+    fn set_environment<F: Float>(c: &mut RgbColours, i: usize, ctx: &Ctx, _: &()) {
+        c.set(i, ctx.scene.environment);
+    }
+    #[inline(always)]
+    fn eval<F: Float, const N: usize>(c: &RgbColours, _: &()) -> Chan<F, N> {
+        chan([F::load(&c.0[0]), F::load(&c.0[1]), F::load(&c.0[2])])
+    }
+    #[inline(always)]
+    fn to_rgb<F: Float, const N: usize>(l: &Chan<F, N>, _: &()) -> V3<F> {
+        V3::new(l.0[0], l.0[1], l.0[2])
     }
     #[inline(always)]
     fn source_radiance(_: &Ctx, _: &LightSource, rgb: Vec3, _: &()) -> Vec3 {
@@ -306,23 +437,8 @@ impl Transport for Rgb {
         rgb * scale
     }
     #[inline(always)]
-    fn environment(ctx: &Ctx, _: &()) -> Vec3 {
-        ctx.scene.environment
-    }
-    #[inline(always)]
-    fn eta(ior: &IorModel, _: &mut (), _: &mut Vec3) -> f32 {
-        match *ior {
-            IorModel::Constant(n) => n,
-            ref m => m.eta(crate::spectrum::LAMBDA_D),
-        }
-    }
-    #[inline(always)]
     fn medium(ctx: &Ctx, m: u32, _: &()) -> HomogeneousMedium {
         ctx.scene.prims.media[m as usize]
-    }
-    #[inline(always)]
-    fn to_rgb(l: Vec3, _: &()) -> Vec3 {
-        l
     }
 }
 
@@ -335,62 +451,238 @@ fn sigmoid4(s: &RgbSigmoid, lam: &Wavelengths) -> SampledSpectrum {
     SampledSpectrum(s.eval4(lam.lambda))
 }
 
+/// Each lane's spectrum as the few numbers that define it, evaluated over lanes at the lanes'
+/// wavelengths: k · P(λ) · D(λ) · s₂ · s₁ · σ(c₀t² + c₁t + c₂), multiplied in the order the
+/// one-path spectra multiply, so both give the same bits. A reflectance sets c and s₁; an RGB
+/// emitter also s₂ and D, the unit-luminance D65; a physically defined emitter (Planck, a
+/// named illuminant) is evaluated for its lane when it is set (P, rare); a point light's
+/// falloff is k.
+pub struct SpectralColours {
+    c: [[f32; MAX_W]; 3],
+    s1: [f32; MAX_W],
+    s2: [f32; MAX_W],
+    k: [f32; MAX_W],
+    /// Lanes with D65 (bit i: lane i) and with a physically defined spectrum P.
+    d65: u32,
+    phys: u32,
+    p: [[f32; MAX_W]; N_LAMBDA],
+}
+
+impl SpectralColours {
+    #[inline(always)]
+    fn sigmoid(&mut self, i: usize, s: &RgbSigmoid) {
+        let c = s.coeffs();
+        (self.c[0][i], self.c[1][i], self.c[2][i]) = (c[0], c[1], c[2]);
+        (self.s1[i], self.s2[i], self.k[i]) = (s.scale(), 1.0, 1.0);
+        let bit = !(1u32 << i);
+        self.d65 &= bit;
+        self.phys &= bit;
+    }
+
+    /// Lane `i` emits `spec` (times the reflectance `tint`, a texture's, if any) times `k`.
+    #[inline(always)]
+    fn emitter<F: Float>(
+        &mut self,
+        i: usize,
+        spec: &EmitSpec,
+        tint: Option<Vec3>,
+        k: f32,
+        lam: &LaneWavelengths<F>,
+    ) {
+        match (spec, tint) {
+            (EmitSpec::Zero | EmitSpec::Physical(EmitterSpectrum::Rgb), _) => {
+                self.sigmoid(i, &RgbSigmoid::grey(0.0))
+            }
+            (EmitSpec::Rgb(s), _) => {
+                self.sigmoid(i, &s.shape());
+                self.s2[i] = s.scale();
+                self.d65 |= 1 << i;
+            }
+            (EmitSpec::Physical(_), t) => {
+                let shape = t.map_or(RgbSigmoid::grey(1.0), RgbSigmoid::from_rgb);
+                self.sigmoid(i, &shape);
+                let v = spec.eval(&lam.lane(i));
+                for (p, v) in self.p.iter_mut().zip(v.0) {
+                    p[i] = v;
+                }
+                self.phys |= 1 << i;
+            }
+        }
+        self.k[i] = k;
+    }
+}
+
 impl Transport for Spectral {
     const SPECTRAL: bool = true;
     type S = SampledSpectrum;
     type Lambda = Wavelengths;
+    type Lanes<F: Float> = LaneWavelengths<F>;
+    type Colours = SpectralColours;
     type Med = SpectralMedium;
 
     #[inline(always)]
-    fn wavelengths(ctx: &Ctx, pixel: u32, index: u32) -> Wavelengths {
+    fn no_lanes<F: Float>() -> LaneWavelengths<F> {
+        LaneWavelengths::zero()
+    }
+    #[inline(always)]
+    fn wavelengths<F: Float>(ctx: &Ctx, pixel: F::U32, sample: F::U32) -> LaneWavelengths<F> {
         if let Some(lambda) = ctx.monochromatic {
-            return Wavelengths {
-                lambda: [lambda; 4],
-                pdf: [1.0, 0.0, 0.0, 0.0],
-            };
+            return LaneWavelengths::monochromatic(lambda);
         }
-        let u = ctx.sampler.get_1d(pixel, index, super::ctx::DIM_WAVELENGTH);
-        let mut lam = Wavelengths::sample_visible(u);
+        let dim = F::U32::splat(super::ctx::DIM_WAVELENGTH);
+        let u = ctx.sampler.get_1d_lanes::<F>(pixel, sample, dim);
+        let mut lam = LaneWavelengths::sample_visible(u);
         if ctx.single_wavelength {
-            lam.terminate_secondary();
+            lam.terminate_secondary(F::Mask::splat(true));
         }
         lam
     }
     #[inline(always)]
-    fn initial_beta(lam: &Wavelengths) -> SampledSpectrum {
-        SampledSpectrum(lam.pdf.map(|p| if p > 0.0 { 1.0 } else { 0.0 }))
+    fn select_lanes<F: Float>(
+        m: F::Mask,
+        a: LaneWavelengths<F>,
+        b: LaneWavelengths<F>,
+    ) -> LaneWavelengths<F> {
+        LaneWavelengths::select(m, a, b)
     }
     #[inline(always)]
-    fn reflectance(
+    fn lane<F: Float>(lam: &LaneWavelengths<F>, i: usize) -> Wavelengths {
+        lam.lane(i)
+    }
+    #[inline(always)]
+    fn initial_beta<F: Float, const N: usize>(lam: &LaneWavelengths<F>) -> Chan<F, N> {
+        let mut b = [F::zero(); N_LAMBDA];
+        for (b, p) in b.iter_mut().zip(lam.pdf) {
+            *b = F::select(p.gt(F::zero()), F::one(), F::zero());
+        }
+        chan(b)
+    }
+    #[inline(always)]
+    fn ior<F: Float>(model: &IorModel, lam: &LaneWavelengths<F>, i: usize) -> (f32, bool) {
+        match *model {
+            IorModel::Constant(n) => (n, false),
+            // Each wavelength would refract its own way: only the hero goes on.
+            ref m => (m.eta(lam.lambda[0].lane(i)), true),
+        }
+    }
+    #[inline(always)]
+    fn terminate_secondary<F: Float, const N: usize>(
+        lam: &mut LaneWavelengths<F>,
+        beta: &mut Chan<F, N>,
+        m: F::Mask,
+    ) {
+        let changed = lam.terminate_secondary(m);
+        for b in &mut beta.0[1..] {
+            *b = F::select(changed, F::zero(), *b);
+        }
+    }
+    #[inline(always)]
+    fn colours() -> SpectralColours {
+        SpectralColours {
+            c: [[0.0; MAX_W]; 3],
+            s1: [0.0; MAX_W],
+            s2: [1.0; MAX_W],
+            k: [1.0; MAX_W],
+            d65: 0,
+            phys: 0,
+            p: [[1.0; MAX_W]; N_LAMBDA],
+        }
+    }
+    #[inline(always)]
+    fn set_reflectance(
+        c: &mut SpectralColours,
+        i: usize,
         ctx: &Ctx,
         mat: u32,
         rgb: Vec3,
         textured: bool,
-        lam: &Wavelengths,
-    ) -> SampledSpectrum {
+    ) {
         if textured {
-            sigmoid4(&RgbSigmoid::from_rgb(rgb), lam)
+            c.sigmoid(i, &RgbSigmoid::from_rgb(rgb));
         } else {
-            sigmoid4(&ctx.spectral.refl[mat as usize], lam)
+            c.sigmoid(i, &ctx.spectral.refl[mat as usize]);
         }
     }
     #[inline(always)]
-    fn emission(
+    fn set_emission<F: Float>(
+        c: &mut SpectralColours,
+        i: usize,
         ctx: &Ctx,
         mat: u32,
         le: Vec3,
         tex: Option<Vec3>,
-        lam: &Wavelengths,
-    ) -> SampledSpectrum {
+        lam: &LaneWavelengths<F>,
+    ) {
         let spec = &ctx.spectral.emit[mat as usize];
         match (tex, spec) {
-            (None, s) => s.eval(lam),
             // A textured RGB emitter: the modulated colour is the emitter's colour.
-            (Some(_), EmitSpec::Rgb(_)) => {
-                SampledSpectrum(RgbIlluminant::from_rgb(le).eval4(lam.lambda))
-            }
-            (Some(t), s) => s.eval(lam) * sigmoid4(&RgbSigmoid::from_rgb(t), lam),
+            (Some(_), EmitSpec::Rgb(_)) => c.emitter(
+                i,
+                &EmitSpec::Rgb(RgbIlluminant::from_rgb(le)),
+                None,
+                1.0,
+                lam,
+            ),
+            (t, s) => c.emitter(i, s, t, 1.0, lam),
         }
+    }
+    #[inline(always)]
+    fn set_source<F: Float>(
+        c: &mut SpectralColours,
+        i: usize,
+        ctx: &Ctx,
+        source: &LightSource,
+        rgb: Vec3,
+        lam: &LaneWavelengths<F>,
+    ) {
+        match *source {
+            LightSource::Area { material, tex, .. } => {
+                Self::set_emission(c, i, ctx, material, rgb, tex, lam)
+            }
+            LightSource::Point { light, scale } => {
+                c.emitter(i, &ctx.spectral.point[light as usize], None, scale, lam)
+            }
+            LightSource::Environment => Self::set_environment(c, i, ctx, lam),
+        }
+    }
+    #[inline(always)]
+    fn set_environment<F: Float>(
+        c: &mut SpectralColours,
+        i: usize,
+        ctx: &Ctx,
+        lam: &LaneWavelengths<F>,
+    ) {
+        let env = ctx.spectral.environment.unwrap_or(EmitSpec::Zero);
+        c.emitter(i, &env, None, 1.0, lam);
+    }
+    #[inline(always)]
+    fn eval<F: Float, const N: usize>(c: &SpectralColours, lam: &LaneWavelengths<F>) -> Chan<F, N> {
+        let coeffs = [F::load(&c.c[0]), F::load(&c.c[1]), F::load(&c.c[2])];
+        let (s1, s2, k) = (F::load(&c.s1), F::load(&c.s2), F::load(&c.k));
+        let d65 = mask_from_bits::<F>(c.d65);
+        let phys = mask_from_bits::<F>(c.phys);
+        // A loop, not a closure: closures this size are not always inlined.
+        let mut out = [F::zero(); N_LAMBDA];
+        for (w, out) in out.iter_mut().enumerate() {
+            let l = lam.lambda[w];
+            let mut v = spectrum_lanes::sigmoid(&coeffs, s1, l) * s2;
+            if c.d65 != 0 {
+                v = F::select(d65, v * spectrum_lanes::illuminant(l), v);
+            }
+            if c.phys != 0 {
+                v = F::select(phys, v * F::load(&c.p[w]), v);
+            }
+            *out = v * k;
+        }
+        chan(out)
+    }
+    #[inline(always)]
+    fn to_rgb<F: Float, const N: usize>(l: &Chan<F, N>, lam: &LaneWavelengths<F>) -> V3<F> {
+        let mut a = [F::zero(); N_LAMBDA];
+        for (a, l) in a.iter_mut().zip(l.0) {
+            *a = l;
+        }
+        spectrum_lanes::to_linear_srgb(&a, lam)
     }
     #[inline(always)]
     fn source_radiance(
@@ -400,11 +692,23 @@ impl Transport for Spectral {
         lam: &Wavelengths,
     ) -> SampledSpectrum {
         match *source {
-            LightSource::Area { material, tex, .. } => Self::emission(ctx, material, rgb, tex, lam),
+            LightSource::Area { material, tex, .. } => {
+                let spec = &ctx.spectral.emit[material as usize];
+                match (tex, spec) {
+                    (None, s) => s.eval(lam),
+                    (Some(_), EmitSpec::Rgb(_)) => {
+                        SampledSpectrum(RgbIlluminant::from_rgb(rgb).eval4(lam.lambda))
+                    }
+                    (Some(t), s) => s.eval(lam) * sigmoid4(&RgbSigmoid::from_rgb(t), lam),
+                }
+            }
             LightSource::Point { light, scale } => {
                 Self::point_radiance(ctx, light, rgb, scale, lam)
             }
-            LightSource::Environment => Self::environment(ctx, lam),
+            LightSource::Environment => ctx
+                .spectral
+                .environment
+                .map_or(SampledSpectrum::ZERO, |e| e.eval(lam)),
         }
     }
     #[inline(always)]
@@ -418,28 +722,6 @@ impl Transport for Spectral {
         ctx.spectral.point[light as usize].eval(lam) * scale
     }
     #[inline(always)]
-    fn environment(ctx: &Ctx, lam: &Wavelengths) -> SampledSpectrum {
-        ctx.spectral
-            .environment
-            .map_or(SampledSpectrum::ZERO, |e| e.eval(lam))
-    }
-    #[inline(always)]
-    fn eta(ior: &IorModel, lam: &mut Wavelengths, beta: &mut SampledSpectrum) -> f32 {
-        match *ior {
-            IorModel::Constant(n) => n,
-            ref m => {
-                // Each wavelength would refract its own way: only the hero goes on.
-                if !lam.secondary_terminated() {
-                    lam.terminate_secondary();
-                    for b in &mut beta.0[1..] {
-                        *b = 0.0;
-                    }
-                }
-                m.eta(lam.lambda[0])
-            }
-        }
-    }
-    #[inline(always)]
     fn medium(ctx: &Ctx, m: u32, lam: &Wavelengths) -> SpectralMedium {
         let (a, s, g) = &ctx.spectral.media[m as usize];
         let sigma_a = SampledSpectrum(a.eval4(lam.lambda));
@@ -449,9 +731,5 @@ impl Transport for Spectral {
             sigma_t: sigma_a + sigma_s,
             g: *g,
         }
-    }
-    #[inline(always)]
-    fn to_rgb(l: SampledSpectrum, lam: &Wavelengths) -> Vec3 {
-        crate::spectrum::xyz_to_linear_srgb(crate::spectrum::to_xyz(&l, lam))
     }
 }

@@ -63,6 +63,17 @@ macro_rules! binops_plain {
     )*};
 }
 
+/// Panics unless every lane's index addresses `len` values: the hardware gathers below read
+/// `s[idx]` unchecked.
+#[inline(always)]
+fn check_gather<U: UInt>(len: usize, idx: U) {
+    let len = u32::try_from(len).unwrap_or(u32::MAX).min(i32::MAX as u32);
+    assert!(
+        idx.lt(U::splat(len)).all(),
+        "gather index out of bounds (len {len})"
+    );
+}
+
 // ---------------------------------------------------------------- AVX2 + FMA, 8 lanes
 
 #[derive(Clone, Copy, Debug)]
@@ -188,6 +199,13 @@ impl Float for F8 {
     #[inline(always)]
     fn lane(self, i: usize) -> f32 {
         self.to_array()[i]
+    }
+    #[inline(always)]
+    fn gather(s: &[f32], idx: U8) -> Self {
+        check_gather(s.len(), idx);
+        // SAFETY: the type's invariant; every index is below `s.len()` and `i32::MAX`
+        // (checked above), so each lane reads inside `s`.
+        F8(unsafe { _mm256_i32gather_ps::<4>(s.as_ptr(), idx.0) })
     }
     #[inline(always)]
     fn load(s: &[f32]) -> Self {
@@ -567,6 +585,13 @@ impl Float for F16 {
     #[inline(always)]
     fn lane(self, i: usize) -> f32 {
         self.to_array()[i]
+    }
+    #[inline(always)]
+    fn gather(s: &[f32], idx: U16) -> Self {
+        check_gather(s.len(), idx);
+        // SAFETY: the type's invariant; every index is below `s.len()` and `i32::MAX`
+        // (checked above), so each lane reads inside `s`.
+        F16(unsafe { _mm512_i32gather_ps::<4>(idx.0, s.as_ptr()) })
     }
     #[inline(always)]
     fn load(s: &[f32]) -> Self {

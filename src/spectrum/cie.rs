@@ -62,7 +62,7 @@ pub(super) fn cmf_row(row: usize) -> [f64; 3] {
 
 /// The tables in f32 for the per-path lookups: f32 holds them to 6·10⁻⁸ relative, far below
 /// the tables' own precision, and spares two conversions per entry on every path.
-static CMF_F32: [[f32; 3]; CMF_ROWS] = {
+pub(super) static CMF_F32: [[f32; 3]; CMF_ROWS] = {
     let mut t = [[0.0f32; 3]; CMF_ROWS];
     let mut i = 0;
     while i < CMF_ROWS {

@@ -16,6 +16,7 @@ mod cie;
 mod cie_data;
 mod emitter;
 mod ior;
+pub mod lanes;
 pub mod rgb2spec;
 mod sampled;
 

@@ -23,7 +23,6 @@
 //! [`RgbSigmoid::coeffs_nm`] converts to the nm form.
 
 use std::sync::OnceLock;
-use std::sync::atomic::{AtomicUsize, Ordering};
 
 use glam::{DVec3, Vec3};
 
@@ -31,9 +30,11 @@ use super::cie::{CMF_ROWS, D65_Y_SUM, cmf_row, d65_at_nm};
 use super::{CIE_Y_INTEGRAL, LAMBDA_MAX, LAMBDA_MIN, SRGB_TO_XYZ, Spectrum, d65};
 
 /// Centre of the normalised wavelength, nm.
-const T_CENTRE: f32 = 0.5 * (LAMBDA_MIN + LAMBDA_MAX);
+pub(super) const T_CENTRE: f32 = 0.5 * (LAMBDA_MIN + LAMBDA_MAX);
 /// Half-width of the normalised wavelength, nm.
-const T_HALF: f32 = 0.5 * (LAMBDA_MAX - LAMBDA_MIN);
+pub(super) const T_HALF: f32 = 0.5 * (LAMBDA_MAX - LAMBDA_MIN);
+/// Its reciprocal: evaluation multiplies (a division costs several multiplications' time).
+pub(super) const INV_T_HALF: f32 = 1.0 / T_HALF;
 
 /// σ(x) = ½ + x/(2√(1+x²)): maps ℝ onto (0, 1), with σ(±∞) = 0 or 1.
 ///
@@ -129,7 +130,7 @@ impl RgbSigmoid {
     /// Reflectance at `lambda` nm.
     #[inline(always)]
     pub fn eval(&self, lambda: f32) -> f32 {
-        let t = (lambda - T_CENTRE) / T_HALF;
+        let t = (lambda - T_CENTRE) * INV_T_HALF;
         self.scale * sigmoid((self.c[0] * t + self.c[1]) * t + self.c[2])
     }
 
@@ -138,7 +139,7 @@ impl RgbSigmoid {
     #[inline(always)]
     pub fn eval4(&self, lambda: [f32; 4]) -> [f32; 4] {
         use glam::Vec4;
-        let t = (Vec4::from_array(lambda) - Vec4::splat(T_CENTRE)) / T_HALF;
+        let t = (Vec4::from_array(lambda) - Vec4::splat(T_CENTRE)) * INV_T_HALF;
         let x = (Vec4::splat(self.c[0]) * t + Vec4::splat(self.c[1])) * t + Vec4::splat(self.c[2]);
         // The same cancellation-free form as `sigmoid`: the tail 1/(2r(r + |x|)) on the
         // dark side, one minus it on the bright side.
@@ -233,7 +234,7 @@ fn delta_e(s: RgbSigmoid, rgb: Vec3) -> f32 {
 const D65_LUMINANCE: f32 = (D65_Y_SUM / CIE_Y_INTEGRAL as f64) as f32;
 
 /// D65 of luminance 1 at every nm of the visible range, for [`RgbIlluminant::illuminant4`].
-static ILLUMINANT_1NM: [f32; 471] = {
+pub(super) static ILLUMINANT_1NM: [f32; 471] = {
     let mut t = [0.0f32; 471];
     let mut i = 0;
     while i < t.len() {
@@ -260,6 +261,16 @@ impl RgbIlluminant {
     /// as 0.
     pub fn from_rgb(rgb: Vec3) -> Self {
         Self(RgbUnbounded::from_rgb(rgb))
+    }
+
+    /// The sigmoid spectrum whose multiple this is (see [`RgbIlluminant::scale`]).
+    pub fn shape(&self) -> RgbSigmoid {
+        self.0.shape
+    }
+
+    /// The factor on [`RgbIlluminant::shape`] (before the illuminant): 2·max(rgb).
+    pub fn scale(&self) -> f32 {
+        self.0.scale
     }
 
     /// Spectral radiance at `lambda` nm.
@@ -648,76 +659,41 @@ fn ratio_coord(r: f32) -> f32 {
 
 /// The stored spectrum of a table cell (see [`table_cell_rgb`]).
 pub fn table_cell(channel: usize, k: usize, j: usize, i: usize) -> RgbSigmoid {
-    RgbSigmoid::from_coeffs(table().coeffs[cell_index(channel, k, j, i)])
+    RgbSigmoid::from_coeffs(table().line(channel, j, i)[k])
 }
 
-/// Builds the coefficient table now rather than at the first
-/// [`RgbSigmoid::from_rgb`], e.g. before timing a render.
+/// Fits every cell of the table now rather than as colours need them (see [`Table`]), e.g.
+/// to time the whole fit.
 pub fn init_table() {
-    table();
+    const R: usize = TABLE_RES;
+    let t = table();
+    for line in 0..3 * R * R {
+        t.line(line / (R * R), (line / R) % R, line % R);
+    }
 }
 
-fn cell_index(channel: usize, k: usize, j: usize, i: usize) -> usize {
-    ((channel * TABLE_RES + k) * TABLE_RES + j) * TABLE_RES + i
-}
-
+/// The coefficient table, fitted lazily one z-line at a time.
+///
+/// Each (channel, x, y) line is walked along z from a mid-dark start outwards, each fit
+/// starting from its neighbour's result: neighbouring colours have nearby optima, so
+/// Gauss–Newton converges in a few steps and always to the same smooth family of solutions.
+/// Lines do not depend on each other, so a line is fitted the first time a colour needs it
+/// (a lookup reads at most four): a scene with a handful of colours fits a few dozen of the
+/// 3,072 lines, about a millisecond, where the whole table took 80 ms at every spectral
+/// render's start. The result is the same whichever thread or order fits a line.
 struct Table {
     z: [f32; TABLE_RES],
-    coeffs: Vec<[f32; 3]>,
+    lines: Vec<OnceLock<[[f32; 3]; TABLE_RES]>>,
 }
 
 fn table() -> &'static Table {
     static T: OnceLock<Table> = OnceLock::new();
-    T.get_or_init(build_table)
-}
-
-/// Fits every cell. Each (channel, x, y) line is walked along z from a
-/// mid-dark start outwards, each fit starting from its neighbour's result:
-/// neighbouring colours have nearby optima, so Gauss–Newton converges in a
-/// few steps and always to the same smooth family of solutions.
-///
-/// Lines are shared among plain scoped threads rather than rayon so a
-/// first use from inside a rayon task cannot re-enter the `OnceLock`
-/// through work stealing.
-fn build_table() -> Table {
-    const R: usize = TABLE_RES;
-    let fitter = fitter();
-    let lines = 3 * R * R;
-    let next = AtomicUsize::new(0);
-    let threads = std::thread::available_parallelism()
-        .map_or(1, |n| n.get())
-        .min(16);
-    let mut coeffs = vec![[0.0f32; 3]; 3 * R * R * R];
-    let done: Vec<Vec<(usize, [[f32; 3]; R])>> = std::thread::scope(|s| {
-        let workers: Vec<_> = (0..threads)
-            .map(|_| {
-                s.spawn(|| {
-                    let mut out = Vec::new();
-                    loop {
-                        let line = next.fetch_add(1, Ordering::Relaxed);
-                        if line >= lines {
-                            break out;
-                        }
-                        out.push((line, fit_line(fitter, line)));
-                    }
-                })
-            })
-            .collect();
-        workers
-            .into_iter()
-            .map(|w| w.join().expect("rgb2spec table worker panicked"))
-            .collect()
-    });
-    for (line, cells) in done.into_iter().flatten() {
-        let (channel, j, i) = (line / (R * R), (line / R) % R, line % R);
-        for (k, c) in cells.into_iter().enumerate() {
-            coeffs[cell_index(channel, k, j, i)] = c;
-        }
-    }
-    Table {
+    T.get_or_init(|| Table {
         z: std::array::from_fn(z_node),
-        coeffs,
-    }
+        lines: (0..3 * TABLE_RES * TABLE_RES)
+            .map(|_| OnceLock::new())
+            .collect(),
+    })
 }
 
 /// Fits the z-line of cells for one (channel, y, x) line index.
@@ -755,6 +731,12 @@ fn fit_line(fitter: &Fitter, line: usize) -> [[f32; 3]; TABLE_RES] {
 }
 
 impl Table {
+    /// The z-line of cells (channel, x = `i`, y = `j`), fitted on first use.
+    fn line(&self, channel: usize, j: usize, i: usize) -> &[[f32; 3]; TABLE_RES] {
+        let line = (channel * TABLE_RES + j) * TABLE_RES + i;
+        self.lines[line].get_or_init(|| fit_line(fitter(), line))
+    }
+
     /// Trilinear interpolation of the coefficients for a non-grey colour
     /// in [0, 1]³.
     fn lookup(&self, rgb: [f32; 3]) -> [f32; 3] {
@@ -782,7 +764,7 @@ impl Table {
                 for (kx, wx) in [(xi, 1.0 - dx), (xi + 1, dx)] {
                     let w = wz * wy * wx;
                     if w != 0.0 {
-                        let c = self.coeffs[cell_index(channel, kz, ky, kx)];
+                        let c = self.line(channel, ky, kx)[kz];
                         for (o, v) in out.iter_mut().zip(c) {
                             *o += w * v;
                         }

@@ -12,15 +12,15 @@ use super::{LAMBDA_MAX, LAMBDA_MIN, N_LAMBDA};
 /// (Pharr, Jakob & Humphreys, 4th ed., 2023): it roughly follows the
 /// luminous efficiency so noise is spent where the eye sees it, yet never
 /// reaches zero, so the deep-red and violet ends stay unbiased.
-const VIS_A: f32 = 0.0072;
+pub(super) const VIS_A: f32 = 0.0072;
 /// Centre of the visible-wavelength pdf, nm.
-const VIS_MU: f32 = 538.0;
+pub(super) const VIS_MU: f32 = 538.0;
 /// tanh(A·(LAMBDA_MIN − MU)) and tanh(A·(LAMBDA_MAX − MU)): the CDF of the
 /// sech² pdf is an affine map of tanh, so these bound its range.
-const VIS_T0: f32 = -0.856_910_6;
-const VIS_T1: f32 = 0.970_591_4;
+pub(super) const VIS_T0: f32 = -0.856_910_6;
+pub(super) const VIS_T1: f32 = 0.970_591_4;
 /// A / (T1 − T0): normalises the pdf to integrate to 1 over the range.
-const VIS_NORM: f32 = VIS_A / (VIS_T1 - VIS_T0);
+pub(super) const VIS_NORM: f32 = VIS_A / (VIS_T1 - VIS_T0);
 
 /// The wavelengths one path carries and the density each was drawn with.
 ///
