@@ -5,10 +5,11 @@ use super::RenderStats;
 use super::bsdf::{Chan, Diffuse, Frame};
 use super::ctx::Ctx;
 use super::shadow;
-use super::state::{C, M, Paths, U, gdot, power_heuristic};
+use super::state::{C, M, MAX_W, Paths, U, gdot, power_heuristic};
 use super::surface::Surface;
 use super::transport::{ChannelArray, Transport};
 use crate::scene::light_lanes::LaneLightSample;
+use crate::scene::lights::LightSource;
 use crate::simd::{Float, Mask, UInt};
 
 /// Next-event estimation at the diffuse lanes `dm`: a light sample per lane, its BSDF value
@@ -36,6 +37,8 @@ pub(super) fn light_samples<
     let (ux, uy) =
         ctx.sampler
             .get_2d_lanes::<F>(st.pixel, st.sample, dim.wrapping_add(U::<F>::splat(1)));
+    // Spectral transport evaluates each lane's emitter at the lane's wavelengths.
+    let mut sources = [LightSource::Environment; MAX_W];
     let ls = scene.lights.sample_lanes::<F, MOTION>(
         prims,
         sf.p,
@@ -45,7 +48,7 @@ pub(super) fn light_samples<
         uy,
         st.time,
         ctx.textures,
-        T::SPECTRAL,
+        T::SPECTRAL.then_some(&mut sources),
     );
     let wi = ls.wi;
     let wi_l = frame.to_local(wi);
@@ -59,7 +62,7 @@ pub(super) fn light_samples<
     let f = bsdf.eval(wo_l, wi_l) * cos;
     let pdf = ls.pdf;
     let w = F::select(ls.delta, F::one(), power_heuristic(pdf, bsdf_pdf));
-    let rad = lane_radiance(ctx, st, &ls, ok);
+    let rad = lane_radiance(ctx, st, &ls, &sources, ok);
     let contrib = st.beta * f * rad * (w / pdf);
     let shoot = ok & !contrib.is_zero();
     let (so, sd, t_max) = shadow::from_surface(sf.p, sf.nf, &ls);
@@ -72,15 +75,16 @@ pub(super) fn lane_radiance<F: Float, T: Transport<S: ChannelArray<N>>, const N:
     ctx: &Ctx,
     st: &Paths<F, T, N>,
     ls: &LaneLightSample<F>,
+    sources: &[LightSource; MAX_W],
     m: M<F>,
 ) -> C<F, N> {
     if T::SPECTRAL {
         let mut rad = T::colours();
         let bits = m.bits();
-        for i in 0..F::WIDTH {
+        for (i, source) in sources.iter().enumerate().take(F::WIDTH) {
             if bits >> i & 1 != 0 {
                 let rgb = ls.radiance.lane(i);
-                T::set_source(&mut rad, i, ctx, &ls.sources[i], rgb, &st.lam);
+                T::set_source(&mut rad, i, ctx, source, rgb, &st.lam);
             }
         }
         T::eval(&rad, &st.lam)

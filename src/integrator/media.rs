@@ -119,6 +119,7 @@ pub(super) fn free_flight<
         let u_sel = sampler.get_1d_lanes::<F>(st.pixel, st.sample, plus::<F>(dim, 2));
         let (ux, uy) = sampler.get_2d_lanes::<F>(st.pixel, st.sample, plus::<F>(dim, 3));
         let scene = ctx.scene;
+        let mut sources = [LightSource::Environment; MAX_W];
         let ls = scene.lights.sample_lanes::<F, MOTION>(
             &scene.prims,
             p,
@@ -128,7 +129,7 @@ pub(super) fn free_flight<
             uy,
             st.time,
             ctx.textures,
-            T::SPECTRAL || ctx.equiangular,
+            (T::SPECTRAL || ctx.equiangular).then_some(&mut sources),
         );
         if ls.has.any() {
             let ph = lanes::hg_phase_dirs(wo, ls.wi, g);
@@ -149,7 +150,7 @@ pub(super) fn free_flight<
                             ctx,
                             point,
                             ls.delta.lane(i),
-                            ls.sources[i],
+                            sources[i],
                             ls.pdf.lane(i),
                             ph.lane(i),
                             p.lane(i),
@@ -162,7 +163,7 @@ pub(super) fn free_flight<
             } else {
                 F::select(ls.delta, F::one(), power_heuristic(ls.pdf, ph))
             };
-            let rad = lane_radiance(ctx, st, &ls, ls.has);
+            let rad = lane_radiance(ctx, st, &ls, &sources, ls.has);
             let contrib = st.beta * rad * (ph * w / ls.pdf);
             let shoot = ls.has & !contrib.is_zero() & finite(&contrib);
             // A point in a medium lies on no surface: no offset at this end.

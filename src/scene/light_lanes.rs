@@ -28,9 +28,6 @@ pub struct LaneLightSample<F: Float> {
     pub at_point: M<F>,
     pub q: V3<F>,
     pub nq: V3<F>,
-    /// Each lane's emitter, filled only when asked for (spectral transport evaluates its
-    /// spectrum from it).
-    pub sources: [LightSource; MAX_W],
 }
 
 impl<F: Float> LaneLightSample<F> {
@@ -46,7 +43,6 @@ impl<F: Float> LaneLightSample<F> {
             at_point: no,
             q: V3::zero(),
             nq: V3::zero(),
-            sources: [LightSource::Environment; MAX_W],
         }
     }
 
@@ -84,7 +80,7 @@ impl Lights {
         uy: F,
         time: F,
         textures: bool,
-        sources: bool,
+        mut sources: Option<&mut [LightSource; MAX_W]>,
     ) -> LaneLightSample<F> {
         let mut out = LaneLightSample::none();
         if self.lights.is_empty() || m.none() {
@@ -113,15 +109,17 @@ impl Lights {
             let gm = M::<F>::from_fn(|i| group >> i & 1 != 0);
             if let Some(s) = self.rect_lanes::<F, MOTION>(prims, k, p, gm, pmf, ux, uy, textures) {
                 out.blend(gm, &s);
-                if sources && let LightKind::Area(prim) = self.lights[k as usize] {
+                if let Some(sources) = sources.as_deref_mut()
+                    && let LightKind::Area(prim) = self.lights[k as usize]
+                {
                     let source = LightSource::Area {
                         material: prims.material[prim as usize],
                         tex: None,
                         prim,
                     };
-                    for i in 0..F::WIDTH {
+                    for (i, s) in sources.iter_mut().enumerate().take(F::WIDTH) {
                         if group >> i & 1 != 0 {
-                            out.sources[i] = source;
+                            *s = source;
                         }
                     }
                 }
@@ -155,11 +153,10 @@ impl Lights {
                     at_point: M::<F>::splat(s.point.is_some()),
                     q: V3::splat(q),
                     nq: V3::splat(nq),
-                    sources: [LightSource::Environment; MAX_W],
                 };
                 out.blend(lane, &one);
-                if sources {
-                    out.sources[i] = s.source;
+                if let Some(sources) = sources.as_deref_mut() {
+                    sources[i] = s.source;
                 }
             }
         }
@@ -222,7 +219,6 @@ impl Lights {
             at_point: M::<F>::splat(true),
             q,
             nq: n,
-            sources: [LightSource::Environment; MAX_W],
         })
     }
 }
