@@ -1,4 +1,5 @@
 use clap::Parser;
+use clap::error::ErrorKind;
 use std::process::ExitCode;
 
 fn main() -> ExitCode {
@@ -30,12 +31,13 @@ fn main() -> ExitCode {
             let _ = e.print();
             return ExitCode::SUCCESS;
         }
+        Err(e) if e.kind() == ErrorKind::DisplayHelpOnMissingArgumentOrSubcommand => {
+            // `prism` alone: the help, and clap's exit code for a command line without one.
+            let _ = e.print();
+            return ExitCode::from(2);
+        }
         Err(e) => {
-            // clap's message is the first line; the usage block after it is noise here.
-            let text = e.to_string();
-            let first = text.lines().next().unwrap_or("invalid arguments");
-            let first = first.strip_prefix("error: ").unwrap_or(first);
-            eprintln!("error: {first} (see 'prism --help')");
+            eprintln!("error: {} (see 'prism --help')", one_line(&e.to_string()));
             return ExitCode::from(2);
         }
     };
@@ -45,5 +47,23 @@ fn main() -> ExitCode {
             eprintln!("error: {e}");
             ExitCode::FAILURE
         }
+    }
+}
+
+/// clap's message on one line: everything before its usage block (the missing argument's
+/// name, a "did you mean" tip), its lines joined.
+fn one_line(text: &str) -> String {
+    let parts: Vec<&str> = text
+        .lines()
+        .take_while(|l| !l.starts_with("Usage:") && !l.starts_with("For more information"))
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect();
+    let joined = parts.join(" ").replace(" tip:", "; tip:");
+    let msg = joined.strip_prefix("error: ").unwrap_or(&joined);
+    if msg.is_empty() {
+        "invalid arguments".to_string()
+    } else {
+        msg.to_string()
     }
 }

@@ -231,3 +231,48 @@ fn the_readme_scene_example_loads() {
         prism::scene_file::load_str(&readme[start..end], &root.join("scenes/readme.ron"), &[]);
     assert!(scene.is_ok(), "{}", scene.err().unwrap());
 }
+
+#[test]
+fn a_missing_scene_is_named() {
+    let err = fails(&["render"]);
+    assert!(err.contains("<SCENE>"), "{err}");
+}
+
+#[test]
+fn a_misspelt_flag_keeps_clap_suggestion() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write(dir.path(), "s.ron", GOOD);
+    let err = fails(&["render", scene.to_str().unwrap(), "--sp", "4"]);
+    assert!(err.contains("'--sp'") && err.contains("'--spp'"), "{err}");
+}
+
+#[test]
+fn bare_prism_prints_the_help_and_exits_2() {
+    let out = prism().output().unwrap();
+    assert_eq!(out.status.code(), Some(2));
+    let text = String::from_utf8(out.stderr).unwrap() + &String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.contains("Usage: prism") && text.contains("render"),
+        "{text}"
+    );
+}
+
+#[test]
+fn t_is_short_for_threads() {
+    let dir = tempfile::tempdir().unwrap();
+    let scene = write(dir.path(), "s.ron", GOOD);
+    let out = dir.path().join("o.png");
+    prism()
+        .args([
+            "render",
+            scene.to_str().unwrap(),
+            "-t",
+            "1",
+            "--quiet",
+            "-o",
+        ])
+        .arg(&out)
+        .assert()
+        .success();
+    assert!(out.exists());
+}

@@ -18,7 +18,8 @@ use std::path::{Path, PathBuf};
 #[command(
     name = "prism",
     version,
-    about = "A physically based spectral path tracer for RON scenes"
+    about = "A physically based spectral path tracer for RON scenes",
+    arg_required_else_help = true
 )]
 pub struct Cli {
     #[command(subcommand)]
@@ -69,7 +70,7 @@ pub struct RenderArgs {
     #[arg(long)]
     pub seed: Option<u64>,
     /// Worker threads (default: all cores).
-    #[arg(long)]
+    #[arg(short = 't', long)]
     pub threads: Option<usize>,
     /// Image size WxH (overrides render.width and render.height).
     #[arg(long, value_parser = parse_size)]

@@ -3,6 +3,7 @@
 use super::converge::Row;
 use plotters::prelude::*;
 use std::path::Path;
+use std::sync::OnceLock;
 
 const COLORS: [RGBColor; 8] = [
     RGBColor(31, 119, 180),
@@ -80,8 +81,21 @@ where
     Ok(())
 }
 
+/// Registers the plots' typeface once: DejaVu Sans, compiled in (`assets/fonts/`), so text
+/// is drawn in pure Rust with no system font libraries to find or install.
+fn register_font() -> Result<(), String> {
+    static DONE: OnceLock<Result<(), String>> = OnceLock::new();
+    DONE.get_or_init(|| {
+        let bytes = include_bytes!("../../assets/fonts/DejaVuSans.ttf");
+        plotters::style::register_font("sans-serif", FontStyle::Normal, bytes)
+            .map_err(|_| "the plots' typeface cannot be read".to_string())
+    })
+    .clone()
+}
+
 /// Writes the plot as PNG and SVG.
 pub fn plot(rows: &[Row], names: &[String], png: &Path, svg: &Path) -> Result<(), String> {
+    register_font()?;
     draw(
         BitMapBackend::new(png, (800, 500)).into_drawing_area(),
         rows,
