@@ -276,3 +276,64 @@ fn t_is_short_for_threads() {
         .success();
     assert!(out.exists());
 }
+
+#[test]
+fn a_scene_without_light_warns_and_one_with_light_does_not() {
+    let d = tempfile::tempdir().unwrap();
+    let dark = GOOD.replace("    environment: Constant(Rgb(0.5, 0.5, 0.5)),\n", "");
+    assert_ne!(dark, GOOD);
+    let dark = write(d.path(), "dark.ron", &dark);
+    let lit = write(d.path(), "lit.ron", GOOD);
+    let run = |scene: &Path, quiet: bool| {
+        let mut c = prism();
+        c.args(["render", scene.to_str().unwrap(), "-o"])
+            .arg(d.path().join("o.png"));
+        if quiet {
+            c.arg("--quiet");
+        }
+        let out = c.output().unwrap();
+        assert!(out.status.success());
+        String::from_utf8(out.stderr).unwrap()
+    };
+    let err = run(&dark, false);
+    assert_eq!(
+        err.matches("warning: the scene has no light").count(),
+        1,
+        "{err}"
+    );
+    assert!(
+        !run(&dark, true).contains("warning"),
+        "--quiet hides warnings"
+    );
+    assert!(!run(&lit, false).contains("warning"));
+    let info = prism()
+        .args(["info", dark.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(
+        String::from_utf8(info.stdout)
+            .unwrap()
+            .contains("warning: the scene has no light")
+    );
+}
+
+#[test]
+fn a_light_with_zero_emission_is_named() {
+    let d = tempfile::tempdir().unwrap();
+    let scene = GOOD.replace(
+        "    ],\n)",
+        "        (name: \"dead lamp\", shape: Sphere(center: (0.0, 3.0, 0.0), radius: 0.5),\n         material: Light(emission: Rgb(0.0, 0.0, 0.0))),\n    ],\n)",
+    );
+    assert_ne!(scene, GOOD);
+    let scene = write(d.path(), "s.ron", &scene);
+    let out = prism()
+        .args(["render", scene.to_str().unwrap(), "-o"])
+        .arg(d.path().join("o.png"))
+        .output()
+        .unwrap();
+    let err = String::from_utf8(out.stderr).unwrap();
+    assert!(
+        err.contains("warning: entity \"dead lamp\": a Light with zero emission"),
+        "{err}"
+    );
+}

@@ -7,8 +7,16 @@ use std::path::{Path, PathBuf};
 
 /// Parses Rust-style ranges: `A..B` is A to B − 1, `A..=B` is A to B.
 pub fn parse_range(s: &str) -> Result<Range<u32>, String> {
-    let bad = || format!("expected a frame range like 0..24 or 0..=23, got '{s}'");
+    let bad = || format!("expected a frame, or a range like 0..24 or 0..=23, got '{s}'");
     let num = |v: &str| v.trim().parse::<u32>().map_err(|_| bad());
+    if !s.contains("..") {
+        // One frame.
+        let f = num(s)?;
+        let end = f
+            .checked_add(1)
+            .ok_or_else(|| format!("frame {f} is out of range"))?;
+        return Ok(f..end);
+    }
     if let Some((a, b)) = s.split_once("..=") {
         let (a, b) = (num(a)?, num(b)?);
         if b < a {
@@ -110,7 +118,9 @@ mod tests {
         assert_eq!(parse_range("5..=5").unwrap(), 5..6);
         assert!(parse_range("3..3").is_err());
         assert!(parse_range("a..3").is_err());
-        assert!(parse_range("3").is_err());
+        assert_eq!(parse_range("3").unwrap(), 3..4, "one frame");
+        assert!(parse_range(&u32::MAX.to_string()).is_err());
+        assert!(parse_range("-1").is_err());
     }
 
     #[test]

@@ -90,8 +90,9 @@ pub struct RenderArgs {
     /// PNG exposure in stops.
     #[arg(long, default_value_t = 0.0)]
     pub exposure: f32,
-    /// Render a frame range (Rust syntax: 0..24 or 0..=23); `-o` names frames with a run of
-    /// '#', e.g. out/frame_####.png.
+    /// Render one frame (7) or a range in Rust syntax: 0..24 is frames 0 to 23 (the end is
+    /// excluded), 0..=23 the same; `-o` names frames with a run of '#', e.g.
+    /// out/frame_####.png.
     #[arg(long, value_parser = frames::parse_range)]
     pub frames: Option<std::ops::Range<u32>>,
     /// With --frames: skip frames whose image already exists.
@@ -383,6 +384,11 @@ fn render(a: RenderArgs) -> Result<(), CliError> {
     // Fail on a bad output name before spending time on the render.
     film::ImageFormat::from_path(&output)?;
     let rs = prepare(&scene, &a.force, 0)?;
+    if !a.quiet {
+        for w in rs.warnings() {
+            eprintln!("warning: {w}");
+        }
+    }
     let out = render_to_file(&a, &scene, &rs, &pool, &output, "")?;
     if a.stats {
         print_stats(&rs, &out, &output, pool.current_num_threads());
@@ -477,7 +483,15 @@ fn render_frames(
         // The scene is prepared once; later frames move the camera and rebuild the kd-tree
         // only if primitives move.
         let scene_for_frame = match rs.as_mut() {
-            None => rs.insert(prepare(scene, &a.force, f)?),
+            None => {
+                let r = rs.insert(prepare(scene, &a.force, f)?);
+                if !a.quiet {
+                    for w in r.warnings() {
+                        eprintln!("warning: {w}");
+                    }
+                }
+                r
+            }
             Some(r) => {
                 r.set_frame(scene, &KdParams::default(), f);
                 force_effects(r, &a.force)?;
@@ -597,6 +611,9 @@ fn info(a: InfoArgs) -> Result<(), CliError> {
             "  \"{}\": {:?}, {:?}",
             rs.prims.names[i], rs.prims.kind[i], m
         );
+    }
+    for w in rs.warnings() {
+        println!("warning: {w}");
     }
     println!("effects:");
     for line in rs.effects.to_string().lines() {

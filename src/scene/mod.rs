@@ -46,6 +46,30 @@ pub struct RenderScene {
 }
 
 impl RenderScene {
+    /// What in the scene will surprise its author, one line each: a scene with no light renders
+    /// black, a `Light` with zero emission emits nothing.
+    pub fn warnings(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        if self.lights.is_empty() {
+            out.push(
+                "the scene has no light (no emitter, point or spot light, or environment): \
+                 it renders black"
+                    .to_string(),
+            );
+        }
+        for (i, name) in self.prims.names.iter().enumerate() {
+            let m = &self.prims.materials[self.prims.material[i] as usize];
+            if let crate::components::Material::Light { emission, .. } = m
+                && emission.max_element() <= 0.0
+            {
+                out.push(format!(
+                    "entity \"{name}\": a Light with zero emission emits nothing"
+                ));
+            }
+        }
+        out
+    }
+
     /// Closest hit along `ray` before `t_max`, at `time` when MOTION is on.
     #[inline]
     pub fn intersect<const MOTION: bool>(&self, ray: &Ray, t_max: f32, time: f32) -> Option<Hit> {
