@@ -337,3 +337,26 @@ fn a_light_with_zero_emission_is_named() {
         "{err}"
     );
 }
+
+#[test]
+fn a_camera_inside_an_opaque_shape_is_warned_of() {
+    let d = tempfile::tempdir().unwrap();
+    let inside = GOOD.replace("position: (0.0, 0.0, 4.0)", "position: (0.0, 0.0, 0.5)");
+    assert_ne!(inside, GOOD);
+    let inside = write(d.path(), "inside.ron", &inside);
+    let out = prism()
+        .args(["info", inside.to_str().unwrap()])
+        .output()
+        .unwrap();
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.contains("warning: the camera is inside entity \"ball\""),
+        "{text}"
+    );
+    let outside = write(d.path(), "outside.ron", GOOD);
+    let out = prism()
+        .args(["info", outside.to_str().unwrap()])
+        .output()
+        .unwrap();
+    assert!(!String::from_utf8(out.stdout).unwrap().contains("warning"));
+}

@@ -47,7 +47,8 @@ pub struct RenderScene {
 
 impl RenderScene {
     /// What in the scene will surprise its author, one line each: a scene with no light renders
-    /// black, a `Light` with zero emission emits nothing.
+    /// black, a `Light` with zero emission emits nothing, a camera inside a closed opaque shape
+    /// sees only its inside.
     pub fn warnings(&self) -> Vec<String> {
         let mut out = Vec::new();
         if self.lights.is_empty() {
@@ -64,6 +65,17 @@ impl RenderScene {
             {
                 out.push(format!(
                     "entity \"{name}\": a Light with zero emission emits nothing"
+                ));
+            }
+            let opaque = !matches!(
+                m,
+                crate::components::Material::Dielectric { .. }
+                    | crate::components::Material::Boundary
+            );
+            if opaque && self.prims.contains(i as u32, self.camera.origin).is_some() {
+                out.push(format!(
+                    "the camera is inside entity \"{name}\", a closed opaque shape: it sees only \
+                     its inside"
                 ));
             }
         }

@@ -436,7 +436,7 @@ impl Primitives {
 
     /// Whether point `p` lies inside closed primitive `i` (spheres and boxes, the shapes
     /// that can hold a medium), and the primitive's volume for picking the innermost.
-    fn contains(&self, i: u32, p: Vec3) -> Option<f32> {
+    pub(crate) fn contains(&self, i: u32, p: Vec3) -> Option<f32> {
         let l = self.local[i as usize] as usize;
         match self.kind[i as usize] {
             PrimKind::Sphere => {
