@@ -446,11 +446,6 @@ impl Transport for Rgb {
 #[derive(Clone, Copy, Debug)]
 pub struct Spectral;
 
-#[inline(always)]
-fn sigmoid4(s: &RgbSigmoid, lam: &Wavelengths) -> SampledSpectrum {
-    SampledSpectrum(s.eval4(lam.lambda))
-}
-
 /// Each lane's spectrum as the few numbers that define it, evaluated over lanes at the lanes'
 /// wavelengths: k · P(λ) · D(λ) · s₂ · s₁ · σ(c₀t² + c₁t + c₂), multiplied in the order the
 /// one-path spectra multiply, so both give the same bits. A reflectance sets c and s₁; an RGB
@@ -691,35 +686,24 @@ impl Transport for Spectral {
         rgb: Vec3,
         lam: &Wavelengths,
     ) -> SampledSpectrum {
-        match *source {
-            LightSource::Area { material, tex, .. } => {
-                let spec = &ctx.spectral.emit[material as usize];
-                match (tex, spec) {
-                    (None, s) => s.eval(lam),
-                    (Some(_), EmitSpec::Rgb(_)) => {
-                        SampledSpectrum(RgbIlluminant::from_rgb(rgb).eval4(lam.lambda))
-                    }
-                    (Some(t), s) => s.eval(lam) * sigmoid4(&RgbSigmoid::from_rgb(t), lam),
-                }
-            }
-            LightSource::Point { light, scale } => {
-                Self::point_radiance(ctx, light, rgb, scale, lam)
-            }
-            LightSource::Environment => ctx
-                .spectral
-                .environment
-                .map_or(SampledSpectrum::ZERO, |e| e.eval(lam)),
-        }
+        // The lane code at width 1: one description of every emitter's spectrum.
+        let lanes = LaneWavelengths::<f32> {
+            lambda: lam.lambda,
+            pdf: lam.pdf,
+        };
+        let mut c = Self::colours();
+        Self::set_source::<f32>(&mut c, 0, ctx, source, rgb, &lanes);
+        SampledSpectrum(Self::eval::<f32, N_LAMBDA>(&c, &lanes).0)
     }
     #[inline(always)]
     fn point_radiance(
         ctx: &Ctx,
         light: u32,
-        _: Vec3,
+        rgb: Vec3,
         scale: f32,
         lam: &Wavelengths,
     ) -> SampledSpectrum {
-        ctx.spectral.point[light as usize].eval(lam) * scale
+        Self::source_radiance(ctx, &LightSource::Point { light, scale }, rgb, lam)
     }
     #[inline(always)]
     fn medium(ctx: &Ctx, m: u32, lam: &Wavelengths) -> SpectralMedium {
