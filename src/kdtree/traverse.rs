@@ -73,6 +73,9 @@ impl KdTree {
     /// Closest hit, a leaf at a time: `isect(leaf, t_max_now)` returns the closest hit among
     /// the leaf's primitives with `0 < t < t_max_now`, if any. For callers that test a leaf's
     /// primitives together (several at once, from data laid out along [`KdTree::runs`]).
+    /// Always inlined: a mesh's walk runs inside a lane type's entry point, so that its leaf
+    /// test is compiled for that instruction set.
+    #[inline(always)]
     pub fn closest_hit_leaves(
         &self,
         ray: &Ray,
@@ -118,7 +121,8 @@ impl KdTree {
     }
 
     /// Any hit before `t_max`, a leaf at a time: stops at the first leaf for which
-    /// `occluded(leaf, t_max)` returns true.
+    /// `occluded(leaf, t_max)` returns true. Always inlined, as `closest_hit_leaves`.
+    #[inline(always)]
     pub fn any_hit_leaves(
         &self,
         ray: &Ray,
@@ -146,7 +150,7 @@ impl KdTree {
     /// Visits the non-empty leaves the ray passes through, front to back.
     /// `leaf(leaf, t_far, limit)` returns the new limit (pending subtrees starting beyond it are
     /// skipped), or `None` to stop.
-    #[inline]
+    #[inline(always)]
     fn walk(&self, ray: &Ray, t_max: f32, leaf: impl FnMut(Leaf<'_>, f32, f32) -> Option<f32>) {
         // The stack is a local array, initialised on every call: sized to the tree's depth
         // rather than to the deepest possible tree, a shallow instance tree does not clear
@@ -158,7 +162,7 @@ impl KdTree {
         }
     }
 
-    #[inline]
+    #[inline(always)]
     fn walk_with<const N: usize>(
         &self,
         ray: &Ray,
@@ -200,7 +204,7 @@ impl KdTree {
     /// or beyond the segment), done with selects instead of branches when `SELECTS` is set,
     /// since incoherent rays mispredict them often. Other rays, parallel to split planes or
     /// lying in them, take the general step.
-    #[inline]
+    #[inline(always)]
     fn walk_from<const N: usize, const OBLIQUE: bool, const SELECTS: bool>(
         &self,
         ray: &Ray,

@@ -89,7 +89,7 @@ impl RenderScene {
         self.accel.closest_hit(ray, t_max, |prim, t_max| {
             let (t, u, v, sub) = self
                 .prims
-                .intersect_sub_at::<MOTION>(prim, ray, t_max, time)?;
+                .intersect_sub_at::<f32, MOTION>(prim, ray, t_max, time)?;
             best = Some(Hit { t, prim, sub, u, v });
             Some(t)
         })?;
@@ -165,9 +165,7 @@ impl RenderScene {
     #[inline]
     pub fn occluded<const MOTION: bool>(&self, ray: &Ray, t_max: f32, time: f32) -> bool {
         self.accel.any_hit(ray, t_max, |prim, t_max| {
-            self.prims
-                .intersect_at::<MOTION>(prim, ray, t_max, time)
-                .is_some()
+            self.prims.occluded_at::<f32, MOTION>(prim, ray, t_max, time)
         })
     }
 }

@@ -199,7 +199,7 @@ impl RenderScene {
             }
             let lim = limit.lane(k);
             if let Some((t, u, v, sub)) =
-                prims.intersect_sub_at::<MOTION>(p, &ray_lane(o, d, k), lim, time.lane(k))
+                prims.intersect_sub_at::<F, MOTION>(p, &ray_lane(o, d, k), lim, time.lane(k))
                 && t < lim
             {
                 h.set_lane(
@@ -294,10 +294,12 @@ impl RenderScene {
         let mut hit = 0u32;
         for k in 0..F::WIDTH {
             if bits >> k & 1 != 0
-                && self
-                    .prims
-                    .intersect_at::<MOTION>(p, &ray_lane(o, d, k), t_max.lane(k), time.lane(k))
-                    .is_some()
+                && self.prims.occluded_at::<F, MOTION>(
+                    p,
+                    &ray_lane(o, d, k),
+                    t_max.lane(k),
+                    time.lane(k),
+                )
             {
                 hit |= 1 << k;
             }

@@ -8,6 +8,7 @@ use crate::geometry::{
     RigidMotion, Sphere, SurfacePoint, TriangleMesh,
 };
 use crate::kdtree::KdPrimitives;
+use crate::simd::Float;
 use glam::{Affine3A, Mat3};
 use glam::{Quat, Vec2, Vec3};
 use std::cell::Cell;
@@ -197,9 +198,9 @@ impl Primitives {
     }
 
     /// Intersects primitive `i` at `time`: a moving primitive is tested in its rest pose.
-    /// Without MOTION no time is looked at.
+    /// Without MOTION no time is looked at. A mesh screens its leaves `F::WIDTH` at a time.
     #[inline]
-    pub fn intersect_at<const MOTION: bool>(
+    pub fn intersect_at<F: Float, const MOTION: bool>(
         &self,
         i: u32,
         ray: &Ray,
@@ -207,14 +208,14 @@ impl Primitives {
         time: f32,
     ) -> Option<(f32, f32, f32)> {
         if MOTION && let Some(m) = self.motion_of(i) {
-            return self.intersect(i, &m.ray_to_rest(ray, time), t_max);
+            return self.intersect::<F>(i, &m.ray_to_rest(ray, time), t_max);
         }
-        self.intersect(i, ray, t_max)
+        self.intersect::<F>(i, ray, t_max)
     }
 
     /// `intersect_at` with the part of the primitive that was hit.
     #[inline]
-    pub fn intersect_sub_at<const MOTION: bool>(
+    pub fn intersect_sub_at<F: Float, const MOTION: bool>(
         &self,
         i: u32,
         ray: &Ray,
@@ -222,9 +223,41 @@ impl Primitives {
         time: f32,
     ) -> Option<(f32, f32, f32, u32)> {
         if MOTION && let Some(m) = self.motion_of(i) {
-            return self.intersect_sub(i, &m.ray_to_rest(ray, time), t_max);
+            return self.intersect_sub::<F>(i, &m.ray_to_rest(ray, time), t_max);
         }
-        self.intersect_sub(i, ray, t_max)
+        self.intersect_sub::<F>(i, ray, t_max)
+    }
+
+    /// Whether primitive `i` blocks `ray` in (0, t_max) at `time`: `intersect_at(..).is_some()`,
+    /// but meshes and revolution surfaces stop at their first hit instead of the nearest.
+    #[inline]
+    pub fn occluded_at<F: Float, const MOTION: bool>(
+        &self,
+        i: u32,
+        ray: &Ray,
+        t_max: f32,
+        time: f32,
+    ) -> bool {
+        if MOTION && let Some(m) = self.motion_of(i) {
+            return self.occluded::<F>(i, &m.ray_to_rest(ray, time), t_max);
+        }
+        self.occluded::<F>(i, ray, t_max)
+    }
+
+    #[inline]
+    fn occluded<F: Float>(&self, i: u32, ray: &Ray, t_max: f32) -> bool {
+        let l = self.local[i as usize] as usize;
+        match self.kind[i as usize] {
+            PrimKind::Revolution => {
+                let r = &self.revolutions[l];
+                with_rev_stats(|st| r.shape.occluded(&r.ray_to_object(ray), t_max, st))
+            }
+            PrimKind::Mesh => {
+                let m = &self.meshes[l];
+                m.shape.occluded_lanes::<F>(&m.ray_to_object(ray), t_max)
+            }
+            _ => self.intersect::<F>(i, ray, t_max).is_some(),
+        }
     }
 
     /// Surface data at `time` (see `intersect_at`). Always inlined, with the analytic
@@ -247,7 +280,7 @@ impl Primitives {
     /// Intersects primitive `i` in the pose of time 0: `Some((t, u, v))` for a hit in
     /// (0, t_max).
     #[inline]
-    pub fn intersect(&self, i: u32, ray: &Ray, t_max: f32) -> Option<(f32, f32, f32)> {
+    pub fn intersect<F: Float>(&self, i: u32, ray: &Ray, t_max: f32) -> Option<(f32, f32, f32)> {
         let l = self.local[i as usize] as usize;
         match self.kind[i as usize] {
             // Closed shapes keep "started outside" in u for the surface stage.
@@ -262,14 +295,19 @@ impl Primitives {
             // The hit keeps the curve parameter in u, the span parameter in v; the span goes
             // through `intersect_sub`.
             PrimKind::Revolution | PrimKind::Mesh => self
-                .intersect_sub(i, ray, t_max)
+                .intersect_sub::<F>(i, ray, t_max)
                 .map(|(t, u, v, _)| (t, u, v)),
         }
     }
 
     /// Like `intersect`, with the part of the primitive that was hit (a revolution's span).
     #[inline]
-    pub fn intersect_sub(&self, i: u32, ray: &Ray, t_max: f32) -> Option<(f32, f32, f32, u32)> {
+    pub fn intersect_sub<F: Float>(
+        &self,
+        i: u32,
+        ray: &Ray,
+        t_max: f32,
+    ) -> Option<(f32, f32, f32, u32)> {
         let l = self.local[i as usize] as usize;
         match self.kind[i as usize] {
             PrimKind::Revolution => {
@@ -281,10 +319,12 @@ impl Primitives {
             // in `sub`.
             PrimKind::Mesh => {
                 let m = &self.meshes[l];
-                let h = m.shape.intersect(&m.ray_to_object(ray), t_max)?;
+                let h = m.shape.intersect_lanes::<F>(&m.ray_to_object(ray), t_max)?;
                 Some((h.t, h.b1, h.b2, h.tri))
             }
-            _ => self.intersect(i, ray, t_max).map(|(t, u, v)| (t, u, v, 0)),
+            _ => self
+                .intersect::<F>(i, ray, t_max)
+                .map(|(t, u, v)| (t, u, v, 0)),
         }
     }
 

@@ -193,6 +193,11 @@ pub trait Float:
         // Under the SSE rule the second operand wins a comparison with NaN.
         hi.min(lo.max(self))
     }
+    /// Runs `k` at this lane type inside the entry point of its instruction set: for work a
+    /// kernel hands to a function it does not inline (a mesh's own walk), so that the lane
+    /// operations there are compiled for the instructions too.
+    fn enter<K: LaneKernel>(k: K) -> K::Output;
+
     /// Sum of the lanes, in lane order (for reports and tests, not hot loops).
     #[inline(always)]
     fn reduce_sum(self) -> f32 {

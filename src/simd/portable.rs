@@ -3,7 +3,7 @@
 //! Each operation is written to give exactly the bits of the native x86 instruction it stands
 //! for (see [`Float`]'s semantics), so a portable kernel is a bit-exact oracle of the native one.
 
-use super::{Float, Mask, UInt};
+use super::{Float, LaneKernel, Mask, UInt};
 use std::ops::{
     Add, AddAssign, BitAnd, BitAndAssign, BitOr, BitOrAssign, BitXor, Div, DivAssign, Mul,
     MulAssign, Neg, Not, Sub, SubAssign,
@@ -81,6 +81,11 @@ impl Float for f32 {
     type Mask = bool;
     type U32 = u32;
     const WIDTH: usize = 1;
+
+    #[inline(always)]
+    fn enter<K: LaneKernel>(k: K) -> K::Output {
+        k.run::<f32>()
+    }
 
     #[inline(always)]
     fn splat(x: f32) -> Self {
@@ -384,6 +389,11 @@ impl<const N: usize> Float for PortableF32<N> {
     type Mask = PortableMask<N>;
     type U32 = PortableU32<N>;
     const WIDTH: usize = N;
+
+    #[inline(always)]
+    fn enter<K: LaneKernel>(k: K) -> K::Output {
+        k.run::<Self>()
+    }
 
     #[inline(never)]
     fn splat(x: f32) -> Self {

@@ -187,6 +187,13 @@ impl Float for F8 {
     const WIDTH: usize = 8;
 
     #[inline(always)]
+    fn enter<K: LaneKernel>(k: K) -> K::Output {
+        // SAFETY: the type's invariant: code that names this type runs inside a kernel that
+        // `dispatch` started after detecting the instructions `entry_avx2` enables.
+        unsafe { entry_avx2(k) }
+    }
+
+    #[inline(always)]
     fn splat(x: f32) -> Self {
         // SAFETY: the type's invariant.
         F8(unsafe { _mm256_set1_ps(x) })
@@ -571,6 +578,13 @@ impl Float for F16 {
     type Mask = M16;
     type U32 = U16;
     const WIDTH: usize = 16;
+
+    #[inline(always)]
+    fn enter<K: LaneKernel>(k: K) -> K::Output {
+        // SAFETY: the type's invariant: code that names this type runs inside a kernel that
+        // `dispatch` started after detecting the instructions `entry_avx512` enables.
+        unsafe { entry_avx512(k) }
+    }
 
     #[inline(always)]
     fn splat(x: f32) -> Self {
