@@ -221,6 +221,53 @@ fn set_overrides_a_value() {
 }
 
 #[test]
+fn set_reaches_entity_fields_by_name_and_index() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let cornell = root.join("scenes/cornell.ron");
+    let out = prism()
+        .args([
+            "info",
+            cornell.to_str().unwrap(),
+            "--set",
+            r#"entities["red wall"].material.albedo=Rgb(0.1, 0.2, 0.9)"#,
+            "--set",
+            "entities[0].material=Light(emission: Rgb(30.0, 30.0, 30.0))",
+        ])
+        .assert()
+        .success();
+    let text = String::from_utf8(out.get_output().stdout.clone()).unwrap();
+    assert!(
+        text.contains("\"red wall\": Rect, Diffuse(albedo: Rgb(0.1, 0.2, 0.9))"),
+        "{text}"
+    );
+    assert!(
+        text.contains("\"light\": Rect, Light(emission: Rgb(30.0, 30.0, 30.0))"),
+        "{text}"
+    );
+    // The value is checked as the file's own, and the error names the --set.
+    let err = fails(&[
+        "info",
+        cornell.to_str().unwrap(),
+        "--set",
+        r#"entities["red wall"].material.albedo=Rgb(0.1, 0.1, 1.9)"#,
+    ]);
+    assert!(
+        err.contains(r#"--set entities["red wall"].material.albedo"#) && err.contains("[0, 1]"),
+        "{err}"
+    );
+    let err = fails(&[
+        "info",
+        cornell.to_str().unwrap(),
+        "--set",
+        "entities[99].material=Mirror",
+    ]);
+    assert!(
+        err.contains("entities[99] does not exist: the file has 8 entities"),
+        "{err}"
+    );
+}
+
+#[test]
 fn the_readme_scene_example_loads() {
     // The README's scene is the schema's showcase: it must stay a valid scene.
     let root = Path::new(env!("CARGO_MANIFEST_DIR"));
@@ -336,6 +383,38 @@ fn a_light_with_zero_emission_is_named() {
         err.contains("warning: entity \"dead lamp\": a Light with zero emission"),
         "{err}"
     );
+}
+
+#[test]
+fn a_lamp_facing_away_from_everything_is_warned_of() {
+    let d = tempfile::tempdir().unwrap();
+    // A rectangle above the ball; its normal u × v is +y (away from the ball and the camera)
+    // or -y (towards the ball).
+    let lamp = |v: &str| {
+        GOOD.replace(
+            "    ],\n)",
+            &format!(
+                "        (name: \"lamp\", shape: Rect(center: (0.0, 3.0, 0.0), u: (0.5, 0.0, 0.0), v: {v}),\n         material: Light(emission: Rgb(5.0, 5.0, 5.0))),\n    ],\n)"
+            ),
+        )
+    };
+    let info = |text: &str, name: &str| {
+        let scene = write(d.path(), name, text);
+        let out = prism()
+            .args(["info", scene.to_str().unwrap()])
+            .output()
+            .unwrap();
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let away = info(&lamp("(0.0, 0.0, -0.5)"), "away.ron");
+    assert!(
+        away.contains(
+            "warning: entity \"lamp\": a one-sided Light whose front faces no other entity"
+        ),
+        "{away}"
+    );
+    let down = info(&lamp("(0.0, 0.0, 0.5)"), "down.ron");
+    assert!(!down.contains("warning"), "{down}");
 }
 
 #[test]

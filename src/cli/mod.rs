@@ -78,7 +78,8 @@ pub struct RenderArgs {
     /// Stop between whole passes after this many seconds; every pixel keeps the same count.
     #[arg(long, allow_negative_numbers = true)]
     pub time_limit: Option<f64>,
-    /// Override a scene value by path, e.g. render.integrator.fresnel=Schlick.
+    /// Override a scene value by path, e.g. render.integrator.fresnel=Schlick or
+    /// 'entities["floor"].material.albedo=Rgb(0.2, 0.2, 0.2)'.
     #[arg(long = "set", value_parser = parse_key_value)]
     pub set: Vec<(String, String)>,
     /// Simulate an effect the scene does not need (lens, motion, spectral, media, ...).
@@ -607,10 +608,7 @@ fn info(a: InfoArgs) -> Result<(), CliError> {
     println!("entities: {}", rs.prims.len());
     for i in 0..rs.prims.len() {
         let m = rs.prims.materials[rs.prims.material[i] as usize];
-        println!(
-            "  \"{}\": {:?}, {:?}",
-            rs.prims.names[i], rs.prims.kind[i], m
-        );
+        println!("  \"{}\": {:?}, {m}", rs.prims.names[i], rs.prims.kind[i]);
     }
     for w in rs.warnings() {
         println!("warning: {w}");

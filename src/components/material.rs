@@ -62,3 +62,150 @@ impl Material {
         matches!(self, Material::Light { emission, .. } if emission.max_element() > 0.0)
     }
 }
+
+/// `x` to five significant digits: a scale recovered by integrating the spectrum carries
+/// rounding in the last digits of an f32.
+fn significant(x: f32) -> f64 {
+    let x = f64::from(x);
+    if x == 0.0 || !x.is_finite() {
+        return x;
+    }
+    let p = 10f64.powi(4 - x.abs().log10().floor() as i32);
+    (x * p).round() / p
+}
+
+/// RGB in the scene format's syntax.
+struct Rgb(Vec3);
+
+impl std::fmt::Display for Rgb {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        write!(f, "Rgb({:?}, {:?}, {:?})", self.0.x, self.0.y, self.0.z)
+    }
+}
+
+/// The material as a scene file writes it (`Diffuse(albedo: Rgb(0.7, 0.7, 0.7))`); a preset
+/// IOR by its name, a spectral emitter with the luminance its `scale` gave it.
+impl std::fmt::Display for Material {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        use crate::spectrum::{IorPreset, NamedIlluminant, spectrum_to_xyz};
+        match self {
+            Material::Diffuse { albedo } => write!(f, "Diffuse(albedo: {})", Rgb(*albedo)),
+            Material::Mirror { tint } => write!(f, "Mirror(tint: {})", Rgb(*tint)),
+            Material::Dielectric { ior } => {
+                let ior = match IorPreset::ALL.into_iter().find(|p| p.model() == *ior) {
+                    Some(p) => format!("Preset({})", p.name()),
+                    None => match ior {
+                        IorModel::Constant(n) => format!("Constant({n:?})"),
+                        IorModel::Cauchy { a, b } => format!("Cauchy(a: {a:?}, b: {b:?})"),
+                        IorModel::Sellmeier { b, c } => format!(
+                            "Sellmeier(b: ({:?}, {:?}, {:?}), c: ({:?}, {:?}, {:?}))",
+                            b[0], b[1], b[2], c[0], c[1], c[2]
+                        ),
+                        IorModel::Sellmeier4 { b, c } => format!("Sellmeier4(b: {b:?}, c: {c:?})"),
+                    },
+                };
+                write!(f, "Dielectric(ior: {ior})")
+            }
+            Material::Light {
+                emission,
+                two_sided,
+                spectrum,
+            } => {
+                let emission = match spectrum {
+                    EmitterSpectrum::Rgb => Rgb(*emission).to_string(),
+                    EmitterSpectrum::Blackbody(b) => format!(
+                        "Blackbody(kelvin: {:?}, scale: {:?})",
+                        b.kelvin(),
+                        significant(spectrum_to_xyz(|l| b.eval(l)).y)
+                    ),
+                    EmitterSpectrum::Illuminant(i) => format!(
+                        "Illuminant(spectrum: {}, scale: {:?})",
+                        match i.which() {
+                            NamedIlluminant::D65 => "D65",
+                            NamedIlluminant::Sun => "Sun",
+                        },
+                        significant(spectrum_to_xyz(|l| i.eval(l)).y)
+                    ),
+                };
+                if *two_sided {
+                    write!(f, "Light(emission: {emission}, two_sided: true)")
+                } else {
+                    write!(f, "Light(emission: {emission})")
+                }
+            }
+            Material::Boundary => f.write_str("none (a medium's boundary)"),
+        }
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::spectrum::{Blackbody, Illuminant, IorPreset, NamedIlluminant};
+
+    /// `prism info` prints materials as the scene format writes them: each printed form parses
+    /// back as a scene material, and spectral emitters show the scale they were given.
+    #[test]
+    fn materials_print_in_scene_syntax() {
+        let light = |spectrum, two_sided| Material::Light {
+            emission: Vec3::new(1.0, 0.5, 0.25),
+            two_sided,
+            spectrum,
+        };
+        let cases = [
+            (
+                Material::Diffuse {
+                    albedo: Vec3::new(0.7, 0.5, 0.25),
+                },
+                "Diffuse(albedo: Rgb(0.7, 0.5, 0.25))",
+            ),
+            (
+                Material::Mirror { tint: Vec3::ONE },
+                "Mirror(tint: Rgb(1.0, 1.0, 1.0))",
+            ),
+            (
+                Material::Dielectric {
+                    ior: IorModel::Constant(1.5),
+                },
+                "Dielectric(ior: Constant(1.5))",
+            ),
+            (
+                Material::Dielectric {
+                    ior: IorModel::Cauchy { a: 1.5, b: 0.004 },
+                },
+                "Dielectric(ior: Cauchy(a: 1.5, b: 0.004))",
+            ),
+            (
+                Material::Dielectric {
+                    ior: IorPreset::Water.model(),
+                },
+                "Dielectric(ior: Preset(Water))",
+            ),
+            (
+                light(EmitterSpectrum::Rgb, true),
+                "Light(emission: Rgb(1.0, 0.5, 0.25), two_sided: true)",
+            ),
+            (
+                light(
+                    EmitterSpectrum::Blackbody(Blackbody::new(2700.0, 5.0)),
+                    false,
+                ),
+                "Light(emission: Blackbody(kelvin: 2700.0, scale: 5.0))",
+            ),
+            (
+                light(
+                    EmitterSpectrum::Illuminant(Illuminant::new(NamedIlluminant::D65, 2.0)),
+                    false,
+                ),
+                "Light(emission: Illuminant(spectrum: D65, scale: 2.0))",
+            ),
+        ];
+        for (m, want) in cases {
+            let text = m.to_string();
+            assert_eq!(text, want);
+            let parsed = crate::scene_file::load::ron_options()
+                .from_str::<crate::scene_file::schema::Material>(&text);
+            assert!(parsed.is_ok(), "{text}: {parsed:?}");
+        }
+    }
+}

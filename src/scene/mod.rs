@@ -67,6 +67,12 @@ impl RenderScene {
                     "entity \"{name}\": a Light with zero emission emits nothing"
                 ));
             }
+            if self.lamp_faces_nothing(i) {
+                out.push(format!(
+                    "entity \"{name}\": a one-sided Light whose front faces no other entity \
+                     and not the camera lights nothing (turn it, or set two_sided: true)"
+                ));
+            }
             let opaque = !matches!(
                 m,
                 crate::components::Material::Dielectric { .. }
@@ -80,6 +86,41 @@ impl RenderScene {
             }
         }
         out
+    }
+
+    /// Whether primitive `i` is a static one-sided emitting rectangle or disk with every
+    /// other entity's bounds and the camera behind or in its plane: its light reaches nothing.
+    fn lamp_faces_nothing(&self, i: usize) -> bool {
+        use crate::components::Material;
+        let prims = &self.prims;
+        let Material::Light {
+            emission,
+            two_sided: false,
+            ..
+        } = prims.materials[prims.material[i] as usize]
+        else {
+            return false;
+        };
+        if emission.max_element() <= 0.0
+            || !matches!(prims.kind[i], PrimKind::Rect | PrimKind::Disk)
+            || prims.motion[i] != primitives::NO_MOTION
+        {
+            return false;
+        }
+        let pl = &prims.planars[prims.local[i] as usize];
+        let front = |p: glam::Vec3| (p - pl.center).dot(pl.n) > 0.0;
+        let lights_something = (0..prims.len()).any(|j| {
+            let b = prims.bounds_of(j as u32);
+            j != i
+                && (0..8).any(|c| {
+                    front(glam::Vec3::new(
+                        if c & 1 == 0 { b.min.x } else { b.max.x },
+                        if c & 2 == 0 { b.min.y } else { b.max.y },
+                        if c & 4 == 0 { b.min.z } else { b.max.z },
+                    ))
+                })
+        });
+        !lights_something && !front(self.camera.origin)
     }
 
     /// Closest hit along `ray` before `t_max`, at `time` when MOTION is on.
@@ -165,7 +206,8 @@ impl RenderScene {
     #[inline]
     pub fn occluded<const MOTION: bool>(&self, ray: &Ray, t_max: f32, time: f32) -> bool {
         self.accel.any_hit(ray, t_max, |prim, t_max| {
-            self.prims.occluded_at::<f32, MOTION>(prim, ray, t_max, time)
+            self.prims
+                .occluded_at::<f32, MOTION>(prim, ray, t_max, time)
         })
     }
 }

@@ -1,7 +1,7 @@
 //! Scene file → ECS world: parse, apply `--set` overrides, spawn one entity per object.
 
 use super::error::{SceneError, context_at, offset_of};
-use super::schema;
+use super::{patch, schema};
 use crate::components::camera::{CameraKey, CameraPath};
 use crate::components::{Camera, Material, Motion, Name, Shape, Transform};
 use glam::{Affine3A, Quat, Vec3};
@@ -57,10 +57,43 @@ pub fn load_str(
     path: &Path,
     overrides: &[(String, String)],
 ) -> Result<LoadedScene, SceneError> {
-    let mut scene = parse(text, path)?;
     let mut hash = fnv1a(text.as_bytes(), FNV_OFFSET);
+    // Entity paths edit the text, so their values are read and checked as the file's own.
+    let mut patched = std::borrow::Cow::Borrowed(text);
+    let mut spans: Vec<(&str, std::ops::Range<usize>)> = Vec::new();
+    for (k, v) in overrides.iter().filter(|(k, _)| patch::is_entity_path(k)) {
+        let (new, span) = patch::apply(&patched, k, v).map_err(|message| SceneError::Override {
+            key: k.clone(),
+            message,
+        })?;
+        let delta = new.len() as isize - patched.len() as isize;
+        for (_, s) in &mut spans {
+            if s.start >= span.start {
+                *s = s.start.saturating_add_signed(delta)..s.end.saturating_add_signed(delta);
+            }
+        }
+        spans.push((k, span));
+        patched = std::borrow::Cow::Owned(new);
+    }
+    let mut scene = parse(&patched, path).map_err(|e| match &e {
+        SceneError::Parse {
+            line, col, message, ..
+        } => {
+            let at = offset_of(&patched, *line, *col);
+            match spans.iter().find(|(_, s)| s.start <= at && at <= s.end) {
+                Some((k, s)) => SceneError::Override {
+                    key: k.to_string(),
+                    message: format!("cannot use '{}': {message}", &patched[s.clone()]),
+                },
+                None => e,
+            }
+        }
+        _ => e,
+    })?;
     for (k, v) in overrides {
-        apply_override(&mut scene, k, v)?;
+        if !patch::is_entity_path(k) {
+            apply_override(&mut scene, k, v)?;
+        }
         if k != "render.spp" {
             hash = fnv1a(k.as_bytes(), hash);
             hash = fnv1a(v.as_bytes(), hash);
@@ -183,7 +216,11 @@ pub fn apply_override(scene: &mut schema::Scene, key: &str, value: &str) -> Resu
         _ => {
             return Err(SceneError::Override {
                 key: key.to_string(),
-                message: format!("unknown key; valid keys: {}", OVERRIDE_KEYS.join(", ")),
+                message: format!(
+                    "unknown key; valid keys: {}, and entity fields as entities[INDEX].field or \
+                     entities[\"NAME\"].field",
+                    OVERRIDE_KEYS.join(", ")
+                ),
             });
         }
     }

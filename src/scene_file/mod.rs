@@ -2,6 +2,7 @@
 
 pub mod error;
 pub mod load;
+pub mod patch;
 pub mod schema;
 
 pub use error::SceneError;
