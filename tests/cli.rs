@@ -439,3 +439,33 @@ fn a_camera_inside_an_opaque_shape_is_warned_of() {
         .unwrap();
     assert!(!String::from_utf8(out.stdout).unwrap().contains("warning"));
 }
+
+#[test]
+fn docs_cli_names_every_option_and_set_key() {
+    use clap::CommandFactory;
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let doc = std::fs::read_to_string(root.join("docs/cli.md")).unwrap();
+    for key in prism::scene_file::load::OVERRIDE_KEYS {
+        assert!(
+            doc.contains(&format!("`{key}`")),
+            "docs/cli.md lacks --set key {key}"
+        );
+    }
+    let cli = prism::cli::Cli::command();
+    for sub in cli.get_subcommands() {
+        assert!(
+            doc.contains(&format!("`prism {}", sub.get_name())),
+            "docs/cli.md lacks a section for prism {}",
+            sub.get_name()
+        );
+        for arg in sub.get_arguments().filter(|a| !a.is_hide_set()) {
+            if let Some(long) = arg.get_long() {
+                assert!(
+                    doc.contains(&format!("--{long}")),
+                    "docs/cli.md lacks prism {} --{long}",
+                    sub.get_name()
+                );
+            }
+        }
+    }
+}

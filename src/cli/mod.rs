@@ -41,10 +41,13 @@ pub enum Command {
     Costs {
         #[arg(required = true)]
         scenes: Vec<PathBuf>,
+        /// Samples per pixel of each timed render.
         #[arg(long, default_value_t = 4)]
         spp: u32,
+        /// Timed renders per configuration; the median is reported.
         #[arg(long, default_value_t = 5)]
         runs: usize,
+        /// Image size WxH (default: each scene's own).
         #[arg(long, value_parser = parse_size)]
         size: Option<(u32, u32)>,
     },
@@ -52,6 +55,7 @@ pub enum Command {
     Merge {
         #[arg(required = true)]
         parts: Vec<PathBuf>,
+        /// The merged EXR.
         #[arg(short, long)]
         output: PathBuf,
     },
@@ -147,11 +151,13 @@ pub struct ConvergeArgs {
     /// kd.intersect_cost, kd.traversal_cost, kd.empty_bonus, kd.max_leaf_prims, or any --set key.
     #[arg(long, value_parser = parse_vary)]
     pub vary: Vec<(String, Vec<String>)>,
+    /// Override a scene value by path for every configuration, as render's --set.
     #[arg(long = "set", value_parser = parse_key_value)]
     pub set: Vec<(String, String)>,
     /// Image size WxH for the study and its reference.
     #[arg(long, value_parser = parse_size)]
     pub size: Option<(u32, u32)>,
+    /// No progress output.
     #[arg(short, long)]
     pub quiet: bool,
 }
@@ -172,8 +178,10 @@ fn parse_vary(s: &str) -> Result<(String, Vec<String>), String> {
 #[derive(Args, Debug)]
 pub struct InfoArgs {
     pub scene: PathBuf,
+    /// Override a scene value by path, as render's --set.
     #[arg(long = "set", value_parser = parse_key_value)]
     pub set: Vec<(String, String)>,
+    /// Show the manifest with an effect forced on, as render's --force.
     #[arg(long)]
     pub force: Vec<String>,
 }
