@@ -13,6 +13,7 @@ pub mod cli;
 pub mod components;
 pub mod film;
 pub mod geometry;
+pub mod imageio;
 pub mod integrator;
 pub mod kdtree;
 pub mod medium;

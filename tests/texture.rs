@@ -7,9 +7,10 @@ use std::sync::Arc;
 use glam::{Vec2, Vec3};
 use image::ImageEncoder;
 use prism::film::{ImageMeta, PngOptions, write_image};
+use prism::scene_file::schema::TextureSpec;
 use prism::texture::{
     AlbedoTexture, Bricks, Checker, ColorSpace, NormalMap, TexImage, Texture, TextureCache,
-    TextureError, TextureSpec, Wood, Wrap, perturb, tangent_frame,
+    TextureError, Wood, Wrap, perturb, tangent_frame,
 };
 
 const WRAPS: [Wrap; 3] = [Wrap::Repeat, Wrap::Clamp, Wrap::Mirror];

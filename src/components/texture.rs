@@ -2,7 +2,7 @@
 //! mapping.
 //!
 //! ```
-//! # use prism::texture::TextureSpec;
+//! # use prism::scene_file::schema::TextureSpec;
 //! let t: TextureSpec = ron::from_str(
 //!     "(albedo: Some(Bricks(brick: Rgb(0.5, 0.15, 0.1), mortar: Rgb(0.8, 0.8, 0.75), size: (0.4, 0.2))),
 //!       normal_map: Some(FromHeight(strength: 1.0)), scale: Some((2.0, 2.0)))",

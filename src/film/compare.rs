@@ -2,7 +2,7 @@
 
 use std::path::Path;
 
-use super::output::{FilmError, Image, read_image};
+use crate::imageio::{FilmError, Image, read_image};
 
 /// Per-channel error statistics of an image against a reference.
 ///
@@ -121,7 +121,7 @@ pub fn relmse_trimmed(a: &Image, b: &Image, drop: f64) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
-    use crate::film::output::{ImageMeta, PngOptions, write_image};
+    use crate::imageio::{ImageMeta, PngOptions, write_image};
 
     #[test]
     fn trimmed_relmse_drops_only_the_worst_pixels() {

@@ -1,10 +1,9 @@
-//! The film: tile films and their accumulation into the image, images, their files (PNG, EXR
-//! with provenance), and comparison.
+//! The film: tile films and their accumulation into the image, and comparison of images. Image
+//! files live in [`crate::imageio`], re-exported here.
 
 pub mod compare;
-pub mod output;
 pub mod tile;
 
+pub use crate::imageio::*;
 pub use compare::*;
-pub use output::*;
 pub use tile::{Film, TILE, Tile, TileFilm, mean_image, tiles};

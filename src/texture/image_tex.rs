@@ -10,7 +10,7 @@ use std::sync::Arc;
 use glam::{Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 
-use crate::film::output::{FilmError, read_image, srgb_decode};
+use crate::imageio::{FilmError, read_image, srgb_decode};
 
 /// How texture coordinates outside [0, 1] are folded back onto the image.
 ///
@@ -85,7 +85,7 @@ impl TextureError {
     }
 }
 
-use crate::film::output::io_reason;
+use crate::imageio::io_reason;
 
 /// A decoded texture: linear RGB, row-major, top row of the file first.
 ///

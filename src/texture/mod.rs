@@ -14,14 +14,12 @@
 
 pub mod image_tex;
 pub mod procedural;
-pub mod schema;
 
 use glam::{Vec2, Vec3};
 use std::sync::Arc;
 
 pub use image_tex::{ColorSpace, TEXTURE_EXTENSIONS, TexImage, TextureCache, TextureError, Wrap};
 pub use procedural::{Bricks, Checker, Wood};
-pub use schema::{AlbedoSpec, NormalMapSpec, TextureSpec};
 
 /// Reflectance as a function of uv, linear RGB.
 #[derive(Clone, Debug, PartialEq)]

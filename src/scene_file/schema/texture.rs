@@ -17,10 +17,10 @@ use std::path::Path;
 use glam::Vec2;
 use serde::Deserialize;
 
-use super::image_tex::{ColorSpace, TextureCache, TextureError, Wrap};
-use super::procedural::{Bricks, Checker, Wood};
-use super::{AlbedoTexture, NormalMap, Texture};
-use crate::scene_file::schema::{Albedo, NonNegative, Positive};
+use super::{Albedo, NonNegative, Positive};
+use crate::texture::image_tex::{ColorSpace, TextureCache, TextureError, Wrap};
+use crate::texture::procedural::{Bricks, Checker, Wood};
+use crate::texture::{AlbedoTexture, NormalMap, Texture};
 
 /// The `texture:` field; every part is optional. `scale` and `offset` map surface uv before
 /// lookup: `uv' = uv * scale + offset` (defaults (1, 1) and (0, 0)).

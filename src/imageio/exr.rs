@@ -1,0 +1,236 @@
+//! OpenEXR: exact floats with the render's provenance as text attributes, written with a
+//! deterministic header order; read from any single-part file with R, G and B channels.
+
+use std::io::Cursor;
+use std::path::Path;
+
+use exr::prelude::{self as ex, ReadChannels, ReadLayers, WritableImage};
+
+use super::{
+    ATTR_SAMPLE_OFFSET, ATTR_SCENE_HASH, ATTR_SIMD, ATTR_SPP, FilmError, Image, ImageMeta,
+};
+
+pub(super) fn encode_exr(path: &Path, img: &Image, meta: &ImageMeta) -> Result<Vec<u8>, FilmError> {
+    let width = img.width as usize;
+    let size = (width, img.height as usize);
+    let pixels = &img.pixels;
+    let channels = ex::SpecificChannels::rgb(move |pos: ex::Vec2<usize>| {
+        let [r, g, b] = pixels[pos.y() * width + pos.x()];
+        (r, g, b)
+    });
+
+    let mut attributes = ex::LayerAttributes::default();
+    for (name, value) in [
+        (ATTR_SPP, meta.spp.to_string()),
+        (ATTR_SAMPLE_OFFSET, meta.sample_offset.to_string()),
+        (ATTR_SCENE_HASH, format!("{:#018x}", meta.scene_hash)),
+    ]
+    .into_iter()
+    .chain(meta.simd.map(|w| (ATTR_SIMD, w.to_string())))
+    {
+        attributes.other.insert(
+            ex::Text::from(name),
+            ex::AttributeValue::Text(ex::Text::from(value.as_str())),
+        );
+    }
+
+    // ZIP over 16-line blocks: lossless, compact, and readable everywhere.
+    let layer = ex::Layer::new(size, attributes, ex::Encoding::SMALL_LOSSLESS, channels);
+    let mut out = Cursor::new(Vec::new());
+    ex::Image::from_layer(layer)
+        .write()
+        .to_buffered(&mut out)
+        .map_err(|e| FilmError::Encode {
+            path: path.to_path_buf(),
+            message: e.to_string(),
+        })?;
+    let mut bytes = out.into_inner();
+    sort_exr_header(&mut bytes);
+    Ok(bytes)
+}
+
+/// Puts the attributes of a single-part EXR header in name order, as OpenEXR writes them. The
+/// `exr` crate writes custom attributes from a `HashMap`, in an order that changes from run to
+/// run, so the same image came out as different bytes. The attributes only move within the
+/// header, whose length stays the same, so the offsets after it still hold. Anything that does
+/// not parse as expected (multi-part or deep files) is left as it is.
+fn sort_exr_header(bytes: &mut [u8]) {
+    let Some(mut attrs) = exr_header_attributes(bytes) else {
+        return;
+    };
+    let (Some(first), Some(last)) = (attrs.first(), attrs.last()) else {
+        return;
+    };
+    let (header_start, header_end) = (first.start, last.end);
+    attrs.sort_by(|a, b| bytes[a.start..a.name_end].cmp(&bytes[b.start..b.name_end]));
+    let header: Vec<u8> = attrs
+        .iter()
+        .flat_map(|a| bytes[a.start..a.end].iter().copied())
+        .collect();
+    bytes[header_start..header_end].copy_from_slice(&header);
+}
+
+/// Where an attribute of an EXR header lies: its name is `start..name_end`, the whole
+/// attribute (name, type, size, value) `start..end`.
+pub(super) struct ExrAttribute {
+    pub(super) start: usize,
+    pub(super) name_end: usize,
+    pub(super) end: usize,
+}
+
+/// The attributes of a single-part EXR header in file order; `None` for multi-part or deep
+/// files, or bytes that do not parse as a header.
+pub(super) fn exr_header_attributes(bytes: &[u8]) -> Option<Vec<ExrAttribute>> {
+    const MULTIPART_OR_DEEP: u32 = (1 << 11) | (1 << 12);
+    let word = |at: usize| -> Option<[u8; 4]> { bytes.get(at..at + 4)?.try_into().ok() };
+    if u32::from_le_bytes(word(4)?) & MULTIPART_OR_DEEP != 0 {
+        return None;
+    }
+    let nul = |from: usize| Some(from + bytes.get(from..)?.iter().position(|&b| b == 0)?);
+    // Each attribute: name, NUL, type, NUL, a 4-byte little-endian size, the value; a NUL
+    // where the next name would start ends the header.
+    let mut attrs = Vec::new();
+    let mut at = 8;
+    while *bytes.get(at)? != 0 {
+        let name_end = nul(at)?;
+        let type_end = nul(name_end + 1)?;
+        let size = usize::try_from(i32::from_le_bytes(word(type_end + 1)?)).ok()?;
+        let end = type_end + 5 + size;
+        if end > bytes.len() {
+            return None;
+        }
+        attrs.push(ExrAttribute {
+            start: at,
+            name_end,
+            end,
+        });
+        at = end;
+    }
+    Some(attrs)
+}
+
+pub(super) fn decode_exr(
+    path: &Path,
+    bytes: Vec<u8>,
+) -> Result<(Image, Option<ImageMeta>), FilmError> {
+    let exr_image = ex::read()
+        .no_deep_data()
+        .largest_resolution_level()
+        .all_channels()
+        .all_layers()
+        .all_attributes()
+        .from_buffered(Cursor::new(bytes))
+        .map_err(|e| match e {
+            ex::Error::Io(error) => FilmError::Read {
+                path: path.to_path_buf(),
+                error,
+            },
+            other => FilmError::Decode {
+                path: path.to_path_buf(),
+                message: other.to_string(),
+            },
+        })?;
+
+    let find = |layer: &ex::Layer<ex::AnyChannels<ex::FlatSamples>>, name: &str| {
+        layer.channel_data.list.iter().position(|c| c.name.eq(name))
+    };
+    let chosen = exr_image.layer_data.iter().find_map(|layer| {
+        match (find(layer, "R"), find(layer, "G"), find(layer, "B")) {
+            (Some(r), Some(g), Some(b)) => Some((layer, [r, g, b])),
+            _ => None,
+        }
+    });
+    let Some((layer, [r, g, b])) = chosen else {
+        return Err(missing_channel(path, &exr_image.layer_data));
+    };
+
+    let list = &layer.channel_data.list;
+    let (width, height) = (layer.size.width(), layer.size.height());
+    let too_big = || FilmError::Decode {
+        path: path.to_path_buf(),
+        message: format!("{width}×{height} exceeds the supported image size"),
+    };
+    let w = u32::try_from(width).map_err(|_| too_big())?;
+    let h = u32::try_from(height).map_err(|_| too_big())?;
+    let pixels = list[r]
+        .sample_data
+        .values_as_f32()
+        .zip(list[g].sample_data.values_as_f32())
+        .zip(list[b].sample_data.values_as_f32())
+        .map(|((r, g), b)| [r, g, b])
+        .collect::<Vec<_>>();
+    // Subsampled channels hold fewer samples than pixels; refuse rather than
+    // misplace them.
+    if pixels.len() != width * height {
+        return Err(FilmError::Decode {
+            path: path.to_path_buf(),
+            message: "subsampled R, G or B channels are not supported".to_owned(),
+        });
+    }
+
+    let attrs = [&layer.attributes.other, &exr_image.attributes.other];
+    let text = |name: &str| {
+        attrs.iter().find_map(|map| match map.get(name.as_bytes()) {
+            Some(ex::AttributeValue::Text(t)) => Some(t.to_string()),
+            _ => None,
+        })
+    };
+    let meta = (|| {
+        Some(ImageMeta {
+            spp: text(ATTR_SPP)?.trim().parse().ok()?,
+            sample_offset: text(ATTR_SAMPLE_OFFSET)?.trim().parse().ok()?,
+            scene_hash: parse_hash(&text(ATTR_SCENE_HASH)?)?,
+            simd: text(ATTR_SIMD).and_then(|t| t.trim().parse().ok()),
+        })
+    })();
+
+    Ok((
+        Image {
+            width: w,
+            height: h,
+            pixels,
+        },
+        meta,
+    ))
+}
+
+/// Hex with optional `0x`, the form `write_image` produces.
+fn parse_hash(s: &str) -> Option<u64> {
+    let s = s.trim();
+    let digits = s
+        .strip_prefix("0x")
+        .or_else(|| s.strip_prefix("0X"))
+        .unwrap_or(s);
+    u64::from_str_radix(digits, 16).ok()
+}
+
+/// Reports the first of R, G, B that the first layer lacks, listing what it
+/// does have so a mislabelled file (e.g. `Y`, or `beauty.R`) is obvious.
+fn missing_channel(
+    path: &Path,
+    layers: &[ex::Layer<ex::AnyChannels<ex::FlatSamples>>],
+) -> FilmError {
+    let names: Vec<String> = layers
+        .first()
+        .map(|l| {
+            l.channel_data
+                .list
+                .iter()
+                .map(|c| c.name.to_string())
+                .collect()
+        })
+        .unwrap_or_default();
+    let channel = ["R", "G", "B"]
+        .into_iter()
+        .find(|c| !names.iter().any(|n| n == c))
+        .unwrap_or("R");
+    FilmError::MissingChannel {
+        path: path.to_path_buf(),
+        channel,
+        present: if names.is_empty() {
+            "none".to_owned()
+        } else {
+            names.join(", ")
+        },
+    }
+}

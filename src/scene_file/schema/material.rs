@@ -1,0 +1,237 @@
+//! Materials: their reflectance colours, indices of refraction and emission spectra.
+
+use serde::{Deserialize, Serialize};
+
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum Material {
+    Diffuse {
+        albedo: Albedo,
+    },
+    Mirror {
+        tint: Albedo,
+    },
+    Dielectric {
+        ior: Ior,
+    },
+    Light {
+        emission: Emission,
+        #[serde(default)]
+        two_sided: bool,
+    },
+}
+
+/// Index of refraction: `Constant(n)`, `Cauchy(a:, b:)` (λ in µm), `Sellmeier(b:, c:)` (c in
+/// µm²) or `Preset(name)`. Checked to be finite and ≥ 1 over the simulated 360–830 nm, with no
+/// Sellmeier resonance inside that range.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(try_from = "IorSpec")]
+pub struct Ior(pub crate::spectrum::IorModel);
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+enum IorSpec {
+    Constant(f32),
+    Cauchy {
+        a: f32,
+        b: f32,
+    },
+    Sellmeier {
+        b: (f32, f32, f32),
+        c: (f32, f32, f32),
+    },
+    Preset(IorPresetName),
+}
+
+#[derive(Deserialize)]
+enum IorPresetName {
+    Bk7,
+    FusedSilica,
+    Water,
+    Diamond,
+    Sapphire,
+}
+
+impl TryFrom<IorSpec> for Ior {
+    type Error = String;
+    fn try_from(s: IorSpec) -> Result<Self, String> {
+        use crate::spectrum::{IorModel, IorPreset, LAMBDA_MAX, LAMBDA_MIN};
+        let (model, what) = match s {
+            IorSpec::Constant(n) => (IorModel::Constant(n), format!("Constant({n})")),
+            IorSpec::Cauchy { a, b } => {
+                (IorModel::Cauchy { a, b }, format!("Cauchy(a: {a}, b: {b})"))
+            }
+            IorSpec::Sellmeier { b, c } => {
+                let (b, c) = ([b.0, b.1, b.2], [c.0, c.1, c.2]);
+                if b.iter().chain(&c).any(|v| !v.is_finite() || *v < 0.0) {
+                    return Err(format!(
+                        "Sellmeier coefficients must be finite and >= 0, got b: {b:?}, c: {c:?}"
+                    ));
+                }
+                // A resonance (λ² = c) inside the simulated range would make n infinite there.
+                let (lo, hi) = ((LAMBDA_MIN * 1e-3).powi(2), (LAMBDA_MAX * 1e-3).powi(2));
+                if let Some(ci) = c.iter().find(|&&ci| ci >= lo && ci <= hi) {
+                    return Err(format!(
+                        "Sellmeier c = {ci} µm² puts a resonance at {:.0} nm, inside the \
+                         simulated {LAMBDA_MIN}–{LAMBDA_MAX} nm; c must be < {lo:.4} or > {hi:.4} µm²",
+                        ci.sqrt() * 1e3
+                    ));
+                }
+                (
+                    IorModel::Sellmeier { b, c },
+                    format!("Sellmeier(b: {b:?}, c: {c:?})"),
+                )
+            }
+            IorSpec::Preset(p) => {
+                let p = match p {
+                    IorPresetName::Bk7 => IorPreset::Bk7,
+                    IorPresetName::FusedSilica => IorPreset::FusedSilica,
+                    IorPresetName::Water => IorPreset::Water,
+                    IorPresetName::Diamond => IorPreset::Diamond,
+                    IorPresetName::Sapphire => IorPreset::Sapphire,
+                };
+                return Ok(Ior(p.model()));
+            }
+        };
+        // Every model is smooth in λ on the range once resonances are excluded: checking a
+        // 1 nm grid finds any n < 1 or non-finite value.
+        let mut lambda = LAMBDA_MIN;
+        while lambda <= LAMBDA_MAX {
+            let n = match model {
+                IorModel::Sellmeier { b, c } => {
+                    let l2 = (lambda * 1e-3).powi(2);
+                    let n2: f32 = 1.0 + (0..3).map(|i| b[i] * l2 / (l2 - c[i])).sum::<f32>();
+                    n2.sqrt()
+                }
+                m => m.eta(lambda),
+            };
+            if !(n.is_finite() && n >= 1.0) {
+                return Err(format!(
+                    "ior {what} gives n = {n} at {lambda} nm; it must be a finite number >= 1 \
+                     over {LAMBDA_MIN}–{LAMBDA_MAX} nm"
+                ));
+            }
+            lambda += 1.0;
+        }
+        Ok(Ior(model))
+    }
+}
+
+/// Linear sRGB colour.
+#[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq)]
+pub enum Color {
+    Rgb(f32, f32, f32),
+}
+
+impl Color {
+    pub fn vec(&self) -> glam::Vec3 {
+        let Color::Rgb(r, g, b) = *self;
+        glam::Vec3::new(r, g, b)
+    }
+}
+
+/// A reflectance: every channel in [0, 1], so no surface creates energy.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(try_from = "Color")]
+pub struct Albedo(pub Color);
+
+impl TryFrom<Color> for Albedo {
+    type Error = String;
+    fn try_from(c: Color) -> Result<Self, String> {
+        let v = c.vec();
+        if v.is_finite() && v.min_element() >= 0.0 && v.max_element() <= 1.0 {
+            Ok(Albedo(c))
+        } else {
+            Err(format!(
+                "a reflectance must have every channel in [0, 1], got Rgb({}, {}, {})",
+                v.x, v.y, v.z
+            ))
+        }
+    }
+}
+
+/// Emitted radiance (or a point light's intensity): `Rgb(r, g, b)`, `Blackbody(kelvin:, scale:)`
+/// or `Illuminant(spectrum: D65 | Sun, scale:)`; the spectral ones are normalised to luminance
+/// Y = `scale`. `rgb` is the linear sRGB colour of the emission either way.
+#[derive(Clone, Copy, Debug, Deserialize)]
+#[serde(try_from = "EmissionSpec")]
+pub struct Emission {
+    pub rgb: glam::Vec3,
+    pub spectrum: crate::spectrum::EmitterSpectrum,
+}
+
+impl Emission {
+    pub fn vec(&self) -> glam::Vec3 {
+        self.rgb
+    }
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+enum EmissionSpec {
+    Rgb(f32, f32, f32),
+    Blackbody {
+        kelvin: f32,
+        scale: f32,
+    },
+    Illuminant {
+        spectrum: IlluminantName,
+        scale: f32,
+    },
+}
+
+#[derive(Deserialize)]
+enum IlluminantName {
+    D65,
+    Sun,
+}
+
+impl TryFrom<EmissionSpec> for Emission {
+    type Error = String;
+    fn try_from(s: EmissionSpec) -> Result<Self, String> {
+        use crate::spectrum::{Blackbody, EmitterSpectrum, Illuminant, NamedIlluminant};
+        let check_scale = |scale: f32| {
+            if scale.is_finite() && scale >= 0.0 {
+                Ok(())
+            } else {
+                Err(format!("scale must be a finite number >= 0, got {scale}"))
+            }
+        };
+        let spectrum = match s {
+            EmissionSpec::Rgb(r, g, b) => {
+                return if [r, g, b].iter().all(|c| c.is_finite() && *c >= 0.0) {
+                    Ok(Emission {
+                        rgb: glam::Vec3::new(r, g, b),
+                        spectrum: EmitterSpectrum::Rgb,
+                    })
+                } else {
+                    Err(format!(
+                        "emission must be finite and >= 0 in every channel, got Rgb({r}, {g}, {b})"
+                    ))
+                };
+            }
+            EmissionSpec::Blackbody { kelvin, scale } => {
+                if !(kelvin.is_finite() && (500.0..=1.0e5).contains(&kelvin)) {
+                    return Err(format!(
+                        "kelvin must be in 500..=100000 (a body colder than 500 K emits almost \
+                         nothing visible), got {kelvin}"
+                    ));
+                }
+                check_scale(scale)?;
+                EmitterSpectrum::Blackbody(Blackbody::new(kelvin, scale))
+            }
+            EmissionSpec::Illuminant { spectrum, scale } => {
+                check_scale(scale)?;
+                let which = match spectrum {
+                    IlluminantName::D65 => NamedIlluminant::D65,
+                    IlluminantName::Sun => NamedIlluminant::Sun,
+                };
+                EmitterSpectrum::Illuminant(Illuminant::new(which, scale))
+            }
+        };
+        Ok(Emission {
+            rgb: spectrum.rgb().unwrap_or_default(),
+            spectrum,
+        })
+    }
+}
