@@ -8,6 +8,7 @@
 // `simd` alone may hold `unsafe` (intrinsics behind CPU feature detection); `tests/lanes.rs`
 // checks that no other module does.
 #![deny(unsafe_code)]
+#![warn(missing_docs)]
 
 pub mod cli;
 pub mod components;

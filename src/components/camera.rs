@@ -13,11 +13,17 @@ use glam::{Vec2, Vec3};
 /// One keyframe of a camera path.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct CameraKey {
+    /// Frame number of the key (may be fractional).
     pub frame: f32,
+    /// Eye point, world space.
     pub position: Vec3,
+    /// Point the camera looks at, world space.
     pub look_at: Vec3,
+    /// Up direction; need not be orthogonal to the view direction.
     pub up: Vec3,
+    /// Vertical field of view in degrees.
     pub fov_y: f32,
+    /// Distance from the eye to the plane in focus, scene units.
     pub focus_distance: f32,
 }
 
@@ -29,7 +35,9 @@ pub struct CameraKey {
 /// the last the camera holds still.
 #[derive(Clone, Debug, PartialEq)]
 pub struct CameraPath {
+    /// Frames per second, for animated output.
     pub fps: u32,
+    /// Keyframes in increasing frame order.
     pub keys: Vec<CameraKey>,
 }
 
@@ -114,34 +122,50 @@ impl CameraPath {
     }
 }
 
+/// A pinhole or thin-lens camera as the scene file describes it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Camera {
+    /// Eye point (lens centre), world space.
     pub position: Vec3,
+    /// Point the camera looks at, world space.
     pub look_at: Vec3,
+    /// Up direction; need not be orthogonal to the view direction.
     pub up: Vec3,
+    /// Vertical field of view in degrees.
     pub fov_y: f32,
+    /// Lens radius, scene units; 0 for a pinhole.
     pub aperture_radius: f32,
+    /// Distance from the eye to the plane in focus, scene units.
     pub focus_distance: f32,
     /// 0 for a round aperture, otherwise the number of polygon sides.
     pub blades: u32,
+    /// Shutter (open, close) as fractions of a frame, `0 <= open <= close <= 1`.
     pub shutter: (f32, f32),
 }
 
 /// The camera's orthonormal frame and film scale, computed once per render.
 #[derive(Clone, Copy, Debug)]
 pub struct CameraFrame {
+    /// Eye point, world space.
     pub origin: Vec3,
+    /// Unit view direction.
     pub forward: Vec3,
+    /// Unit right direction of the film, `forward × up`.
     pub right: Vec3,
+    /// Unit up direction of the film, orthogonal to `forward` and `right`.
     pub up: Vec3,
     /// Half extents of the film plane at distance 1.
     pub half: Vec2,
+    /// Lens radius, scene units; 0 for a pinhole.
     pub aperture_radius: f32,
+    /// Distance from the eye to the plane in focus, scene units.
     pub focus_distance: f32,
+    /// 0 for a round aperture, otherwise the number of polygon sides.
     pub blades: u32,
 }
 
 impl Camera {
+    /// The frame for an image of `width` × `height` pixels.
     pub fn frame(&self, width: u32, height: u32) -> CameraFrame {
         let forward = (self.look_at - self.position).normalize();
         let right = forward.cross(self.up).normalize();

@@ -15,13 +15,16 @@
 
 use glam::Vec3;
 
+/// A point or spot light: a position, and for a spot an axis and a cone.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct PointLight {
+    /// Where the light is, world space.
     pub position: Vec3,
     /// Spot axis (unused by a point light).
     pub direction: Vec3,
     /// Linear sRGB intensity; `spectrum` is what spectral transport evaluates.
     pub intensity: Vec3,
+    /// The emission spectrum spectral transport evaluates instead of `intensity`.
     pub spectrum: crate::spectrum::EmitterSpectrum,
     /// Cosine of the cone half-angle: −1 for an omnidirectional point light.
     pub cos_cone: f32,

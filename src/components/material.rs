@@ -17,20 +17,33 @@
 use crate::spectrum::{EmitterSpectrum, IorModel};
 use glam::Vec3;
 
+/// How a surface scatters or emits light.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum Material {
     /// Lambertian reflection.
-    Diffuse { albedo: Vec3 },
+    Diffuse {
+        /// Reflectance per linear sRGB channel, in [0, 1].
+        albedo: Vec3,
+    },
     /// Perfect specular reflection.
-    Mirror { tint: Vec3 },
+    Mirror {
+        /// Reflectance per linear sRGB channel, in [0, 1].
+        tint: Vec3,
+    },
     /// Smooth glass: Fresnel-weighted reflection and refraction. A wavelength-dependent IOR
     /// disperses light (spectral transport only).
-    Dielectric { ior: IorModel },
+    Dielectric {
+        /// Refractive index of the glass as a function of wavelength.
+        ior: IorModel,
+    },
     /// An area emitter of constant radiance: `emission` is its linear sRGB colour, `spectrum`
     /// what spectral transport evaluates.
     Light {
+        /// Emitted radiance, linear sRGB.
         emission: Vec3,
+        /// Emits from both sides, not only the side the normal faces.
         two_sided: bool,
+        /// The emission spectrum spectral transport evaluates instead of `emission`.
         spectrum: EmitterSpectrum,
     },
     /// No surface at all: the boundary of a medium, crossed without scattering.
@@ -58,6 +71,7 @@ impl Material {
         }
     }
 
+    /// Whether this is a `Light` with some non-zero emission.
     pub fn is_emissive(&self) -> bool {
         matches!(self, Material::Light { emission, .. } if emission.max_element() > 0.0)
     }

@@ -25,6 +25,7 @@ pub struct Name(pub String);
 /// Object-to-world placement: scale, then rotation R = Rz·Ry·Rx (degrees), then translation.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Transform {
+    /// Object-to-world matrix.
     pub to_world: Affine3A,
     /// The uniform scale factor when the transform is a similarity (rotation and uniform
     /// scale), which spheres require.

@@ -11,14 +11,17 @@
 
 use glam::Vec3;
 
+/// Rigid motion of an entity: a constant linear and angular velocity.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
 pub struct Motion {
+    /// Scene units per frame.
     pub velocity: Vec3,
     /// Degrees per frame.
     pub angular_velocity: Vec3,
 }
 
 impl Motion {
+    /// Whether the entity does not move.
     pub fn is_static(&self) -> bool {
         self.velocity == Vec3::ZERO && self.angular_velocity == Vec3::ZERO
     }

@@ -19,24 +19,39 @@
 use glam::Vec3;
 use std::sync::Arc;
 
+/// The geometry of an entity, in object space.
 #[derive(Clone, Debug)]
 pub enum Shape {
+    /// A sphere.
     Sphere {
+        /// Centre, object space.
         center: Vec3,
+        /// Radius, scene units.
         radius: f32,
     },
+    /// A parallelogram spanning `center ± u ± v`, facing `normalize(u × v)`.
     Rect {
+        /// Centre, object space.
         center: Vec3,
+        /// Half edge along the first side.
         u: Vec3,
+        /// Half edge along the second side.
         v: Vec3,
     },
+    /// A flat disk.
     Disk {
+        /// Centre, object space.
         center: Vec3,
+        /// Direction the disk faces.
         normal: Vec3,
+        /// Radius, scene units.
         radius: f32,
     },
+    /// A closed axis-aligned box.
     Box {
+        /// Corner with the smallest coordinates.
         min: Vec3,
+        /// Corner with the largest coordinates.
         max: Vec3,
     },
     /// A revolved B-spline profile, shared by every entity with the same profile.
@@ -47,6 +62,7 @@ pub enum Shape {
 }
 
 impl Shape {
+    /// The variant's name as the scene file spells it, for messages.
     pub fn kind_name(&self) -> &'static str {
         match self {
             Shape::Sphere { .. } => "Sphere",

@@ -8,15 +8,21 @@ use glam::Vec3;
 /// Square tiles of this many pixels a side: the unit of parallel work.
 pub const TILE: u32 = 16;
 
+/// A rectangle of the image, in pixels.
 #[derive(Clone, Copy, Debug)]
 pub struct Tile {
+    /// Left column.
     pub x0: u32,
+    /// Top row.
     pub y0: u32,
+    /// Width in pixels (at most [`TILE`]).
     pub w: u32,
+    /// Height in pixels (at most [`TILE`]).
     pub h: u32,
 }
 
 impl Tile {
+    /// Number of pixels in the tile.
     #[inline]
     pub fn pixels(&self) -> usize {
         (self.w * self.h) as usize
@@ -48,17 +54,20 @@ pub fn tiles(width: u32, height: u32) -> Vec<Tile> {
 
 /// One tile's sums of sample radiance, in f64 so that thousands of samples add without loss.
 pub struct TileFilm {
+    /// The part of the image this film covers.
     pub tile: Tile,
     /// The image's width: samples name their pixel by `y * width + x`.
     width: u32,
     /// Per pixel of the tile, row-major.
     pub sums: Vec<[f64; 3]>,
-    /// Samples added, and samples dropped because their radiance was not finite.
+    /// Samples added.
     pub samples: u64,
+    /// Samples dropped because their radiance was not finite.
     pub dropped: u64,
 }
 
 impl TileFilm {
+    /// An empty film for `tile` of an image `width` pixels wide.
     pub fn new(tile: Tile, width: u32) -> Self {
         TileFilm {
             tile,
@@ -89,13 +98,16 @@ impl TileFilm {
 
 /// A whole image's sums of sample radiance.
 pub struct Film {
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     /// Per pixel, row-major, top row first.
     pub sums: Vec<[f64; 3]>,
 }
 
 impl Film {
+    /// An empty film of `width` × `height` pixels.
     pub fn new(width: u32, height: u32) -> Self {
         Film {
             width,

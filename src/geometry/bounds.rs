@@ -3,9 +3,12 @@
 use super::Ray;
 use glam::{Vec3, Vec3A};
 
+/// An axis-aligned box, closed on every side; empty when `min` exceeds `max` on an axis.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Aabb {
+    /// Corner with the smallest coordinates.
     pub min: Vec3,
+    /// Corner with the largest coordinates.
     pub max: Vec3,
 }
 
@@ -16,6 +19,7 @@ impl Aabb {
         max: Vec3::splat(f32::NEG_INFINITY),
     };
 
+    /// The box spanned by two opposite corners, in any order.
     #[inline]
     pub fn new(a: Vec3, b: Vec3) -> Self {
         Self {
@@ -24,11 +28,13 @@ impl Aabb {
         }
     }
 
+    /// The smallest box holding every point ([`Aabb::EMPTY`] for none).
     #[inline]
     pub fn from_points(points: &[Vec3]) -> Self {
         points.iter().fold(Self::EMPTY, |b, &p| b.union_point(p))
     }
 
+    /// The smallest box holding both boxes.
     #[inline]
     pub fn union(&self, o: &Aabb) -> Aabb {
         Aabb {
@@ -37,6 +43,7 @@ impl Aabb {
         }
     }
 
+    /// The smallest box holding this box and `p`.
     #[inline]
     pub fn union_point(&self, p: Vec3) -> Aabb {
         Aabb {
@@ -45,6 +52,7 @@ impl Aabb {
         }
     }
 
+    /// The part common to both boxes; empty if they do not overlap.
     #[inline]
     pub fn intersection(&self, o: &Aabb) -> Aabb {
         Aabb {
@@ -53,21 +61,25 @@ impl Aabb {
         }
     }
 
+    /// Whether the box holds no point.
     #[inline]
     pub fn is_empty(&self) -> bool {
         self.min.x > self.max.x || self.min.y > self.max.y || self.min.z > self.max.z
     }
 
+    /// `max - min`.
     #[inline]
     pub fn diagonal(&self) -> Vec3 {
         self.max - self.min
     }
 
+    /// Midpoint of the box.
     #[inline]
     pub fn center(&self) -> Vec3 {
         (self.min + self.max) * 0.5
     }
 
+    /// Total area of the six faces; 0 for an empty box.
     #[inline]
     pub fn surface_area(&self) -> f32 {
         if self.is_empty() {

@@ -20,9 +20,13 @@ use std::path::{Path, PathBuf};
 /// The arrays a file holds, before `TriangleMesh::new` validates them and builds the tree.
 #[derive(Clone, Debug, Default, PartialEq)]
 pub struct MeshData {
+    /// Vertex positions, object space.
     pub positions: Vec<Vec3>,
+    /// Vertex indices of each triangle.
     pub indices: Vec<[u32; 3]>,
+    /// Per-vertex normals, one per position, if the file has them.
     pub normals: Option<Vec<Vec3>>,
+    /// Per-vertex texture coordinates, one per position, if the file has them.
     pub uvs: Option<Vec<Vec2>>,
 }
 

@@ -8,9 +8,12 @@
 use super::{Aabb, Ray};
 use glam::{Quat, Vec3};
 
+/// A constant linear and angular velocity about a pivot (see the module docs).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RigidMotion {
+    /// Centre of rotation, world space (the object origin at rest).
     pub pivot: Vec3,
+    /// World units per frame.
     pub velocity: Vec3,
     /// Radians per frame about x, y, z.
     pub angular: Vec3,
@@ -23,6 +26,7 @@ impl RigidMotion {
         Quat::from_rotation_z(a.z) * Quat::from_rotation_y(a.y) * Quat::from_rotation_x(a.x)
     }
 
+    /// Whether the motion has any rotation.
     pub fn rotates(&self) -> bool {
         self.angular != Vec3::ZERO
     }
@@ -37,21 +41,25 @@ impl RigidMotion {
         )
     }
 
+    /// World point at time `t` carried into the rest pose.
     #[inline]
     pub fn point_to_rest(&self, p: Vec3, t: f32) -> Vec3 {
         self.pivot + self.rotation(t).inverse() * (p - self.pivot - self.velocity * t)
     }
 
+    /// Rest-pose point carried to its world position at time `t`.
     #[inline]
     pub fn point_to_world(&self, p: Vec3, t: f32) -> Vec3 {
         self.pivot + self.velocity * t + self.rotation(t) * (p - self.pivot)
     }
 
+    /// World direction or normal at time `t` carried into the rest pose.
     #[inline]
     pub fn vector_to_rest(&self, v: Vec3, t: f32) -> Vec3 {
         self.rotation(t).inverse() * v
     }
 
+    /// Rest-pose direction or normal carried to world space at time `t`.
     #[inline]
     pub fn vector_to_world(&self, v: Vec3, t: f32) -> Vec3 {
         self.rotation(t) * v

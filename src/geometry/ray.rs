@@ -7,16 +7,20 @@ use glam::Vec3;
 /// where the transformed direction keeps the world `t`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Ray {
+    /// Origin.
     pub o: Vec3,
+    /// Direction; `t` is measured in multiples of it.
     pub d: Vec3,
 }
 
 impl Ray {
+    /// The ray from `o` along `d`.
     #[inline]
     pub fn new(o: Vec3, d: Vec3) -> Self {
         Self { o, d }
     }
 
+    /// The point at parameter `t`, `o + t d`.
     #[inline]
     pub fn at(&self, t: f32) -> Vec3 {
         self.o + self.d * t

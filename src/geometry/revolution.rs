@@ -119,6 +119,7 @@ impl std::ops::AddAssign for RevolutionStats {
 /// The nearest hit of a ray.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct RevolutionHit {
+    /// Ray parameter of the hit.
     pub t: f32,
     /// Curve parameter over the whole profile, in [0, 1].
     pub s: f32,
@@ -586,10 +587,12 @@ impl Revolution {
         self.closed
     }
 
+    /// Newton convergence threshold in the curve parameter s.
     pub fn tolerance(&self) -> f32 {
         self.tolerance
     }
 
+    /// Number of polynomial spans in the profile (control points − 3).
     pub fn span_count(&self) -> usize {
         self.spans.len()
     }

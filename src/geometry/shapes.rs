@@ -38,7 +38,9 @@ impl SurfacePoint {
 /// A point sampled on an emitter, as seen from a reference point.
 #[derive(Clone, Copy, Debug)]
 pub struct ShapeSample {
+    /// The sampled point, world space.
     pub p: Vec3,
+    /// Unit surface normal at `p` (either side).
     pub n: Vec3,
     /// Density with respect to solid angle at the reference point.
     pub pdf: f32,
@@ -95,11 +97,14 @@ fn solid_angle_pdf_lanes<F: Float>(pdf_area: F, ref_p: V3<F>, p: V3<F>, n: V3<F>
 /// describe them fully.
 #[derive(Clone, Copy, Debug)]
 pub struct Sphere {
+    /// Centre, world space.
     pub center: Vec3,
+    /// Radius, world units.
     pub radius: f32,
 }
 
 impl Sphere {
+    /// World bounds, padded for intersection rounding.
     pub fn bounds(&self) -> Aabb {
         Aabb::new(self.center - self.radius, self.center + self.radius).padded(PAD_REL, 0.0)
     }
@@ -165,6 +170,7 @@ impl Sphere {
         (F::select(first, t0, t1), hit, outside)
     }
 
+    /// Surface data of a hit at `t` found by [`Sphere::intersect`] (`front` is its `outside`).
     #[inline(always)]
     pub fn surface(&self, ray: &Ray, t: f32, front: bool) -> SurfacePoint {
         let rel = ray.at(t) - self.center;
@@ -177,6 +183,7 @@ impl Sphere {
         }
     }
 
+    /// Surface area.
     pub fn area(&self) -> f32 {
         4.0 * std::f32::consts::PI * self.radius * self.radius
     }
@@ -231,8 +238,11 @@ impl Sphere {
 /// are baked to world space and never transform rays.
 #[derive(Clone, Copy, Debug)]
 pub struct Planar {
+    /// Centre, world space.
     pub center: Vec3,
+    /// Half edge (or semi-axis) along α.
     pub u: Vec3,
+    /// Half edge (or semi-axis) along β.
     pub v: Vec3,
     /// Unit normal `normalize(u × v)`.
     pub n: Vec3,
@@ -242,6 +252,7 @@ pub struct Planar {
 }
 
 impl Planar {
+    /// From centre and half edges; `disk` chooses the ellipse, for its area.
     pub fn new(center: Vec3, u: Vec3, v: Vec3, disk: bool) -> Self {
         let nn = u.cross(v);
         let len2 = nn.length_squared();
@@ -256,6 +267,7 @@ impl Planar {
         }
     }
 
+    /// World bounds of the parallelogram, or of the ellipse if `disk`, padded for rounding.
     pub fn bounds(&self, disk: bool) -> Aabb {
         let ext = if disk {
             // An ellipse's extent along each axis is |(u_a, v_a)|.
@@ -327,6 +339,7 @@ impl Planar {
         (self.w.dot(rel.cross(self.v)), self.w.dot(self.u.cross(rel)))
     }
 
+    /// Surface data at the (α, β) a hit returned; `front` when the ray meets the side `n` faces.
     #[inline(always)]
     pub fn surface(&self, ray: &Ray, a: f32, b: f32) -> SurfacePoint {
         SurfacePoint {
@@ -337,6 +350,7 @@ impl Planar {
         }
     }
 
+    /// Surface area.
     pub fn area(&self) -> f32 {
         self.area
     }
@@ -356,6 +370,7 @@ impl Planar {
         (pdf > 0.0 && pdf.is_finite()).then_some(ShapeSample { p, n: self.n, pdf })
     }
 
+    /// Solid-angle density of [`Planar::sample`] at `p` seen from `ref_p`.
     pub fn pdf(&self, ref_p: Vec3, p: Vec3) -> f32 {
         solid_angle_pdf(1.0 / self.area, ref_p, p, self.n)
     }
@@ -377,15 +392,20 @@ impl Planar {
 /// space with a slab test.
 #[derive(Clone, Copy, Debug)]
 pub struct OrientedBox {
+    /// Object-space corner with the smallest coordinates.
     pub min: Vec3,
+    /// Object-space corner with the largest coordinates.
     pub max: Vec3,
+    /// Object-to-world transform.
     pub to_world: Affine3A,
+    /// World-to-object transform, the inverse of `to_world`.
     pub to_object: Affine3A,
     /// Inverse transpose of the linear part: carries normals to world space.
     pub normal_matrix: Mat3,
 }
 
 impl OrientedBox {
+    /// The box `[min, max]` in object space, placed by `to_world`.
     pub fn new(min: Vec3, max: Vec3, to_world: Affine3A) -> Self {
         let to_object = to_world.inverse();
         let normal_matrix = Mat3::from(to_object.matrix3).transpose();
@@ -398,6 +418,7 @@ impl OrientedBox {
         }
     }
 
+    /// World bounds of the transformed corners, padded for rounding.
     pub fn bounds(&self) -> Aabb {
         let mut b = Aabb::EMPTY;
         for i in 0..8 {
@@ -528,6 +549,7 @@ impl OrientedBox {
         (best.1, best.2, best.3)
     }
 
+    /// Surface data of a hit at `t` found by [`OrientedBox::intersect`] (`front` is its `outside`).
     #[inline(always)]
     pub fn surface(&self, ray: &Ray, t: f32, front: bool) -> SurfacePoint {
         let r = self.object_ray(ray);

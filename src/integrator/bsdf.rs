@@ -26,15 +26,20 @@ use std::ops::{Add, Mul};
 /// What a path carries: the BSDF's `sample` scales radiance at refraction, importance not.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Default)]
 pub enum Mode {
+    /// Radiance, on paths traced from the camera.
     #[default]
     Radiance,
+    /// Importance, on paths traced from lights.
     Importance,
 }
 
 /// Lobe flags of a BSDF sample (bits of a `U32` lane).
 pub mod lobe {
+    /// Lambertian reflection.
     pub const DIFFUSE_REFLECTION: u32 = 1;
+    /// Mirror reflection (a delta lobe).
     pub const SPECULAR_REFLECTION: u32 = 2;
+    /// Refraction through a smooth interface (a delta lobe).
     pub const SPECULAR_TRANSMISSION: u32 = 4;
     /// Either specular lobe: no density, so no MIS with light sampling.
     pub const SPECULAR: u32 = SPECULAR_REFLECTION | SPECULAR_TRANSMISSION;
@@ -45,6 +50,7 @@ pub mod lobe {
 pub trait LaneChannels<F: Float>:
     Copy + Mul<Output = Self> + Mul<F, Output = Self> + Add<Output = Self>
 {
+    /// The same value `v` in every channel.
     fn splat(v: F) -> Self;
 }
 
@@ -93,8 +99,11 @@ impl<F: Float, const N: usize> LaneChannels<F> for Chan<F, N> {
 /// An orthonormal shading frame: `n` is local `+z`.
 #[derive(Clone, Copy, Debug)]
 pub struct Frame<F: Float> {
+    /// Unit tangent, local `+x`.
     pub t: V3<F>,
+    /// Unit bitangent, local `+y`.
     pub b: V3<F>,
+    /// Unit shading normal, local `+z`.
     pub n: V3<F>,
 }
 
@@ -105,6 +114,7 @@ impl<F: Float> Frame<F> {
         let (t, b) = crate::sampling::warp::lanes::coordinate_system(n);
         Frame { t, b, n }
     }
+    /// A world direction in the local frame.
     #[inline(always)]
     pub fn to_local(&self, v: V3<F>) -> V3<F> {
         V3::new(v.dot(self.t), v.dot(self.b), v.dot(self.n))
@@ -137,6 +147,7 @@ impl<F: Float, S> BsdfSample<F, S> {
     pub fn is_specular(&self) -> F::Mask {
         !(self.lobe & F::U32::splat(lobe::SPECULAR)).eq(F::U32::splat(0))
     }
+    /// Lanes whose sample refracted.
     #[inline(always)]
     pub fn is_transmission(&self) -> F::Mask {
         !(self.lobe & F::U32::splat(lobe::SPECULAR_TRANSMISSION)).eq(F::U32::splat(0))
@@ -146,6 +157,7 @@ impl<F: Float, S> BsdfSample<F, S> {
 /// Lambertian reflection: f = albedo / π on the side of `+z`.
 #[derive(Clone, Copy, Debug)]
 pub struct Diffuse<S> {
+    /// Reflectance per channel.
     pub albedo: S,
 }
 
@@ -166,6 +178,7 @@ impl<S> Diffuse<S> {
         }
     }
 
+    /// f = albedo / π above the surface, 0 below.
     #[inline(always)]
     pub fn eval<F: Float>(&self, _wo: V3<F>, wi: V3<F>) -> S
     where
@@ -175,6 +188,7 @@ impl<S> Diffuse<S> {
         self.albedo * F::select(above, F::splat(std::f32::consts::FRAC_1_PI), F::zero())
     }
 
+    /// Cosine-weighted solid-angle density of `wi`.
     #[inline(always)]
     pub fn pdf<F: Float>(&self, _wo: V3<F>, wi: V3<F>) -> F {
         cosine_pdf(wi.z)
@@ -189,10 +203,12 @@ fn cosine_pdf<F: Float>(cos: F) -> F {
 /// A perfect mirror tinted by `tint`: one specular lobe.
 #[derive(Clone, Copy, Debug)]
 pub struct Mirror<S> {
+    /// Reflectance per channel.
     pub tint: S,
 }
 
 impl<S> Mirror<S> {
+    /// The mirror direction of `wo`, weighted by the tint.
     #[inline(always)]
     pub fn sample<F: Float>(&self, wo: V3<F>) -> BsdfSample<F, S>
     where
@@ -216,6 +232,7 @@ impl<S> Mirror<S> {
         S::splat(F::zero())
     }
 
+    /// A delta lobe: zero density for every pair of directions.
     #[inline(always)]
     pub fn pdf<F: Float>(&self, _wo: V3<F>, _wi: V3<F>) -> F {
         F::zero()
@@ -227,7 +244,9 @@ impl<S> Mirror<S> {
 /// (transmitted over incident), so a ray leaving glass has `eta` < 1.
 #[derive(Clone, Copy, Debug)]
 pub struct Dielectric<F> {
+    /// Relative IOR, transmitted over incident.
     pub eta: F,
+    /// Use Schlick's approximation for the Fresnel term instead of the exact formula.
     pub schlick: bool,
 }
 

@@ -9,10 +9,15 @@ use crate::scene_file::schema::{Fresnel, LightSampling};
 // Sample dimensions. The layout is fixed whatever the effect set, so an absent effect never
 // shifts the dimensions of the others: a scene renders the same image with or without code
 // for effects it does not use.
+/// Position within the pixel (2 dimensions).
 pub const DIM_FILM: u32 = 0;
+/// Point on the lens (2 dimensions).
 pub const DIM_LENS: u32 = 2;
+/// Time within the shutter (1 dimension).
 pub const DIM_TIME: u32 = 4;
+/// Hero wavelength (1 dimension).
 pub const DIM_WAVELENGTH: u32 = 5;
+/// First dimension of the first scattering event; event k starts `k * DIMS_PER_BOUNCE` later.
 pub const DIM_BOUNCE: u32 = 8;
 /// Dimensions each scattering event may use: light choice (1), light point (2), lobe (1),
 /// direction (2), Russian roulette (1), and one reserved.
@@ -22,22 +27,33 @@ pub const DIMS_PER_BOUNCE: u32 = 8;
 /// equiangular technique's light choice, distance and light point (2). A path may cross
 /// boundaries without scattering, so segments are counted apart from bounces.
 pub const DIM_MEDIA: u32 = 1 << 20;
+/// Dimensions each medium segment may use (see [`DIM_MEDIA`]).
 pub const DIMS_PER_SEGMENT: u32 = 12;
 
 /// Per-render constants of the kernel, hoisted out of the per-ray loop.
 #[derive(Clone, Copy)]
 pub struct Ctx<'a> {
+    /// The scene being rendered.
     pub scene: &'a RenderScene,
+    /// The sample generator, seeded from the render settings.
     pub sampler: Sampler,
+    /// Image width in pixels: pixels are numbered `y * width + x`.
     pub width: u32,
+    /// Scattering events after which a path ends.
     pub max_depth: u32,
+    /// Scattering events before Russian roulette starts.
     pub rr_depth: u32,
+    /// Next-event estimation is on and the scene has lights to sample.
     pub nee: bool,
+    /// Dielectrics use Schlick's Fresnel approximation instead of the exact formula.
     pub schlick: bool,
+    /// LENS: camera rays start on a thin lens instead of a pinhole.
     pub lens: bool,
     /// TEXTURES and NORMAL_MAPS: read once per render, never per ray from the world.
     pub textures: bool,
+    /// NORMAL_MAPS: some surface has a normal map.
     pub normal_maps: bool,
+    /// In media, also sample distances towards lights (equiangular sampling, MIS).
     pub equiangular: bool,
     /// Whether the scene has a pure medium boundary material (an entity with a medium and no
     /// material): the only surface a shadow ray may pass through (MEDIA).
@@ -56,6 +72,7 @@ pub struct Ctx<'a> {
 static NO_SPECTRAL_DATA: SpectralData = SpectralData::EMPTY;
 
 impl<'a> Ctx<'a> {
+    /// The constants of a render of `scene`, with a thin lens if `lens`.
     pub fn new(scene: &'a RenderScene, lens: bool) -> Self {
         let s = &scene.settings;
         Ctx {

@@ -14,8 +14,11 @@ use glam::Vec2;
 /// Camera rays of one lane of samples: where each starts, where it goes, and when.
 #[derive(Clone, Copy, Debug)]
 pub struct CameraRays<F: Float> {
+    /// Ray origins, world space (points on the lens when it has an aperture).
     pub o: V3<F>,
+    /// Unit ray directions.
     pub d: V3<F>,
+    /// Scene time of each ray, in frames.
     pub time: F,
 }
 

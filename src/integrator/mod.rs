@@ -58,7 +58,9 @@ pub struct RenderStats {
     pub samples: u64,
     /// Samples whose radiance was not finite: dropped and counted, never written.
     pub dropped: u64,
+    /// Closest-hit rays traced: camera rays and every bounce.
     pub rays: u64,
+    /// Shadow rays traced for next-event estimation.
     pub shadow_rays: u64,
     /// Lanes offered to paths, one per lane per step (live or not): `rays / lane_slots` is
     /// the mean lane occupancy.
@@ -76,9 +78,11 @@ impl RenderStats {
     }
 }
 
+/// How much of the image to render, and how.
 pub struct RenderOptions {
     /// First sample index of every pixel: sample ranges rendered apart never repeat samples.
     pub sample_offset: u32,
+    /// Samples per pixel to render.
     pub spp: u32,
     /// Stop between whole passes once this many seconds are spent.
     pub time_limit: Option<f64>,
@@ -105,13 +109,17 @@ impl RenderOptions {
 
 /// Linear per-pixel sums of a render and what it cost.
 pub struct RenderOutput {
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
     /// Sum of the radiance of every sample, per pixel (row-major, top row first).
     pub sums: Vec<[f64; 3]>,
     /// Samples per pixel actually rendered (fewer than asked under a time limit).
     pub spp: u32,
+    /// Counters of the render.
     pub stats: RenderStats,
+    /// Wall-clock seconds the render took.
     pub seconds: f64,
     /// The lane width that ran.
     pub lanes: Lanes,

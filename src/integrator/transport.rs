@@ -30,13 +30,19 @@ use glam::Vec3;
 /// methods are always inlined: out of the lane kernels' `target_feature` entry points the
 /// lane math would call `fmaf` and `rintf` for every fused multiply-add and rounding.
 pub trait MediumOps<S>: Copy {
+    /// Scattering coefficient σs per channel (1/scene unit).
     fn sigma_s(&self) -> S;
     /// Extinction σt = σa + σs.
     fn sigma_t(&self) -> S;
     /// Henyey–Greenstein asymmetry.
     fn g(&self) -> f32;
+    /// Transmittance over distance `d` per channel, `exp(−σt·d)`.
     fn transmittance(&self, d: f32) -> S;
+    /// Density per unit length of free-flight sampling drawing `t`, channels chosen in proportion
+    /// to the throughput `probs` ([`lanes::channel_probabilities`]).
     fn distance_pdf(&self, t: f32, probs: S) -> f32;
+    /// Henyey–Greenstein phase function for directions `wo` and `wi`, both pointing away from the
+    /// scattering point.
     fn phase(&self, wo: Vec3, wi: Vec3) -> f32;
 }
 
@@ -108,8 +114,11 @@ impl MediumOps<SampledSpectrum> for SpectralMedium {
 /// How one emitter's spectrum is evaluated in spectral transport.
 #[derive(Clone, Copy, Debug)]
 pub enum EmitSpec {
+    /// Emits nothing.
     Zero,
+    /// An RGB colour upsampled to a smooth illuminant spectrum.
     Rgb(RgbIlluminant),
+    /// A physically defined spectrum (black body or named illuminant).
     Physical(EmitterSpectrum),
 }
 
@@ -156,6 +165,7 @@ pub struct SpectralData {
 }
 
 impl SpectralData {
+    /// No spectral data: what RGB transport carries.
     pub const EMPTY: SpectralData = SpectralData {
         refl: Vec::new(),
         emit: Vec::new(),
@@ -164,6 +174,7 @@ impl SpectralData {
         media: Vec::new(),
     };
 
+    /// The spectral forms of every material, point light, medium and the environment of `scene`.
     pub fn new(scene: &RenderScene) -> Self {
         use crate::components::Material;
         let prims = &scene.prims;
@@ -218,7 +229,9 @@ impl SpectralData {
 
 /// A transport's channels as a plain array, to move them in and out of lanes.
 pub trait ChannelArray<const N: usize>: Channels {
+    /// The channels as an array.
     fn to_array(self) -> [f32; N];
+    /// Channels from an array.
     fn from_array(a: [f32; N]) -> Self;
 }
 
@@ -254,6 +267,7 @@ impl ChannelArray<4> for SampledSpectrum {
 pub trait Transport: Copy + Send + Sync + 'static {
     /// Colours depend on the path's wavelengths.
     const SPECTRAL: bool;
+    /// One path's colour channels: `Vec3` for RGB, four wavelengths' values for spectral.
     type S: Channels;
     /// One path's wavelengths (nothing in RGB).
     type Lambda: Copy + std::fmt::Debug + Default + Send + Sync;
@@ -261,11 +275,14 @@ pub trait Transport: Copy + Send + Sync + 'static {
     type Lanes<F: Float>: Copy;
     /// Colours recorded one lane at a time, evaluated over lanes.
     type Colours;
+    /// A medium evaluated in this transport's channels.
     type Med: MediumOps<Self::S>;
 
+    /// Placeholder wavelengths for lanes without a path.
     fn no_lanes<F: Float>() -> Self::Lanes<F>;
     /// The wavelengths of sample `sample` of pixel `pixel`, in every lane.
     fn wavelengths<F: Float>(ctx: &Ctx, pixel: F::U32, sample: F::U32) -> Self::Lanes<F>;
+    /// `a`'s wavelengths in lanes where `m` is set, else `b`'s.
     fn select_lanes<F: Float>(m: F::Mask, a: Self::Lanes<F>, b: Self::Lanes<F>) -> Self::Lanes<F>;
     /// Lane `i`'s wavelengths.
     fn lane<F: Float>(lam: &Self::Lanes<F>, i: usize) -> Self::Lambda;
@@ -281,6 +298,7 @@ pub trait Transport: Copy + Send + Sync + 'static {
         m: F::Mask,
     );
 
+    /// An empty record of lane colours.
     fn colours() -> Self::Colours;
     /// Lane `i`: material `mat`'s reflectance, `rgb` its (possibly texture-modulated) colour.
     fn set_reflectance(
@@ -318,6 +336,7 @@ pub trait Transport: Copy + Send + Sync + 'static {
     /// The paths' radiance as linear sRGB for the film.
     fn to_rgb<F: Float, const N: usize>(l: &Chan<F, N>, lam: &Self::Lanes<F>) -> V3<F>;
 
+    /// One path's radiance of light sample `ls`.
     #[inline(always)]
     fn light_radiance(ctx: &Ctx, ls: &LightSample, lam: &Self::Lambda) -> Self::S {
         Self::source_radiance(ctx, &ls.source, ls.radiance, lam)
@@ -326,6 +345,7 @@ pub trait Transport: Copy + Send + Sync + 'static {
     fn source_radiance(ctx: &Ctx, source: &LightSource, rgb: Vec3, lam: &Self::Lambda) -> Self::S;
     /// A point light's intensity times `scale` (falloff / d²) for one path.
     fn point_radiance(ctx: &Ctx, light: u32, rgb: Vec3, scale: f32, lam: &Self::Lambda) -> Self::S;
+    /// Medium `m` in this transport's channels, at one path's wavelengths.
     fn medium(ctx: &Ctx, m: u32, lam: &Self::Lambda) -> Self::Med;
 }
 

@@ -114,8 +114,10 @@ impl KdParams {
 
 /// What the builder needs to know of the primitives: it knows boxes, never shapes.
 pub trait KdPrimitives: Sync {
+    /// Number of primitives; indices run over `0..len()`.
     fn len(&self) -> usize;
 
+    /// Whether there are no primitives.
     fn is_empty(&self) -> bool {
         self.len() == 0
     }
@@ -171,8 +173,11 @@ pub struct KdStats {
     pub primitives: usize,
     /// Of those, left out because their bounds were empty or not finite.
     pub skipped: usize,
+    /// Nodes in the tree, interior and leaf.
     pub nodes: usize,
+    /// Leaf nodes, empty ones included.
     pub leaves: usize,
+    /// Leaves holding no primitive.
     pub empty_leaves: usize,
     /// Depth of the deepest leaf (the root is at depth 0).
     pub max_depth: u32,
@@ -180,6 +185,7 @@ pub struct KdStats {
     pub mean_leaf_prims: f32,
     /// Primitive references over all leaves (a straddling primitive counts once per leaf).
     pub prim_refs: usize,
+    /// Wall-clock time of the build, seconds.
     pub build_seconds: f64,
 }
 
@@ -213,6 +219,7 @@ pub struct KdTree {
 }
 
 impl KdTree {
+    /// Builds a tree over `prims` with `params`.
     pub fn build<P: KdPrimitives + ?Sized>(prims: &P, params: &KdParams) -> KdTree {
         let start = Instant::now();
         let built = build::build(prims, params);
@@ -239,6 +246,7 @@ impl KdTree {
         self.bounds
     }
 
+    /// Figures of the build that made this tree.
     pub fn stats(&self) -> &KdStats {
         &self.stats
     }
@@ -328,6 +336,7 @@ impl KdTree {
 /// A non-empty leaf as a walk hands it to the caller.
 #[derive(Clone, Copy, Debug)]
 pub struct Leaf<'a> {
+    /// Indices of the leaf's primitives.
     pub prims: &'a [u32],
     /// Where the leaf's run starts in the index array ([`KdTree::runs`]); `None` for a leaf
     /// of one primitive, which the node holds itself.

@@ -13,12 +13,21 @@ use glam::{DVec3, Vec3};
 pub enum DistanceSample<W = Vec3> {
     /// A real scattering event at distance `t < t_max`. `weight` = σs·Tr(t) / pdf(t)
     /// already includes σs, so only the phase function remains to be applied.
-    Scatter { t: f32, weight: W },
+    Scatter {
+        /// Distance to the event along the ray.
+        t: f32,
+        /// σs·Tr(t) / pdf(t) per channel.
+        weight: W,
+    },
     /// The flight reached `t_max`; `weight` = Tr(t_max) / P(pass).
-    Pass { weight: W },
+    Pass {
+        /// Tr(t_max) / P(pass) per channel.
+        weight: W,
+    },
 }
 
 impl<W> DistanceSample<W> {
+    /// The weight of either event, per channel.
     pub fn weight(&self) -> &W {
         match self {
             Self::Scatter { weight, .. } | Self::Pass { weight } => weight,

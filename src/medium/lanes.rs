@@ -1,12 +1,12 @@
 //! The medium's estimators over lanes: the one implementation every width runs (per lane or
 //! over lanes), so a lane's medium events are those of width 1.
 //!
-//! The f64 functions of [`super::distance`] stay as the accurate statement of the same
-//! estimators, against which these are tested. Here everything is f32, so the ratios of
-//! exponentials in the free-flight weights are taken relative to the largest factor
-//! (`e_k = exp(−(τ_k − τ_ref))`, τ = σt·t) instead of as raw transmittances: the raw
-//! factors span hundreds of orders of magnitude between a dense and a clear channel, the
-//! relative ones stay in [e⁻¹⁰⁴, 1] wherever the estimator can land.
+//! The f64 functions of the parent module ([`super::sample_free_flight`] and its kin) stay as
+//! the accurate statement of the same estimators, against which these are tested. Here
+//! everything is f32, so the ratios of exponentials in the free-flight weights are taken
+//! relative to the largest factor (`e_k = exp(−(τ_k − τ_ref))`, τ = σt·t) instead of as raw
+//! transmittances: the raw factors span hundreds of orders of magnitude between a dense and a
+//! clear channel, the relative ones stay in [e⁻¹⁰⁴, 1] wherever the estimator can land.
 
 use crate::simd::{Float, Mask, V3, math};
 
@@ -53,6 +53,7 @@ pub fn channel_probabilities<F: Float, const N: usize>(beta: &[F; N]) -> [F; N] 
 pub struct FreeFlight<F: Float, const N: usize> {
     /// Lanes that scatter at `t` (the others pass their segment's end).
     pub scatter: F::Mask,
+    /// Distance to the scattering event along the ray (meaningful where `scatter` is set).
     pub t: F,
     /// σs·Tr(t) / pdf(t) where scattering, Tr(t_max) / P(pass) where passing.
     pub weight: [F; N],

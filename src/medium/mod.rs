@@ -58,13 +58,16 @@ use glam::{Vec2, Vec3};
 /// Homogeneous medium coefficients per channel (1/scene unit).
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct HomogeneousMedium {
+    /// Absorption coefficient σa per channel (1/scene unit).
     pub sigma_a: Vec3,
+    /// Scattering coefficient σs per channel (1/scene unit).
     pub sigma_s: Vec3,
     /// Henyey–Greenstein asymmetry in [−1, 1] (see [`hg_phase`] for the convention).
     pub g: f32,
 }
 
 impl HomogeneousMedium {
+    /// From σa, σs and the Henyey–Greenstein asymmetry `g`.
     pub fn new(sigma_a: Vec3, sigma_s: Vec3, g: f32) -> Self {
         Self {
             sigma_a,

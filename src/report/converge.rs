@@ -14,9 +14,13 @@ use std::time::Instant;
 /// One configuration: a name and the settings that differ from the scene's.
 #[derive(Clone, Debug)]
 pub struct Config {
+    /// Label in the table and plots, e.g. `spp=4 rr_depth=3` (`baseline` for the scene as is).
     pub name: String,
+    /// `--set` keys and values applied on top of the scene.
     pub overrides: Vec<(String, String)>,
+    /// Effects forced on regardless of what the scene needs.
     pub force: Vec<Effect>,
+    /// Kd-tree build parameters.
     pub kd: KdParams,
     /// Sample counts to render instead of the doubling ladder.
     pub spp: Option<Vec<u32>>,
@@ -25,33 +29,50 @@ pub struct Config {
 /// One rung of a configuration's ladder.
 #[derive(Clone, Debug)]
 pub struct Row {
+    /// Name of the configuration.
     pub config: String,
+    /// Samples per pixel.
     pub spp: u32,
+    /// Wall-clock seconds of the render, preparation included.
     pub seconds: f64,
+    /// Root-mean-square error against the reference ([`film::Metrics::rmse`]).
     pub rmse: f64,
+    /// Relative mean squared error against the reference ([`film::Metrics::relmse`]).
     pub relmse: f64,
+    /// Structural similarity to the reference (1 is identical).
     pub ssim: f64,
     /// relMSE without the worst 0.1 % of pixels ([`film::relmse_trimmed`]).
     pub relmse_trimmed: f64,
 }
 
+/// What `prism converge` is asked to do.
 pub struct ConvergeOptions {
+    /// The scene file.
     pub scene: PathBuf,
+    /// `--set` overrides applied to every configuration and to the reference.
     pub set: Vec<(String, String)>,
+    /// A reference image to use instead of rendering one.
     pub reference: Option<PathBuf>,
+    /// Samples per pixel of a reference prism renders; ladders stop at a quarter of it.
     pub reference_spp: u32,
     /// Seconds each configuration may spend on its ladder.
     pub budget: f64,
+    /// `--vary` knobs: each key with the values to try.
     pub vary: Vec<(String, Vec<String>)>,
+    /// Directory the CSV, plots, summary and cached reference go to.
     pub out: PathBuf,
+    /// Print no progress.
     pub quiet: bool,
 }
 
+/// What a study produced.
 pub struct ConvergeResult {
+    /// Every rung of every configuration, in render order.
     pub rows: Vec<Row>,
     /// The reference's own estimated relMSE (from two independent halves), when prism
     /// rendered it.
     pub reference_relmse: Option<f64>,
+    /// The Markdown summary written to `summary.md`.
     pub summary: String,
 }
 

@@ -120,10 +120,12 @@ impl AliasTable {
         self.pmf.get(i).copied().unwrap_or(0.0)
     }
 
+    /// Number of entries.
     pub fn len(&self) -> usize {
         self.bins.len()
     }
 
+    /// Whether the table has no entries (and so cannot be sampled).
     pub fn is_empty(&self) -> bool {
         self.bins.is_empty()
     }

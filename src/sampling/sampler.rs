@@ -97,10 +97,12 @@ impl Sampler {
         }
     }
 
+    /// The generator this sampler uses.
     pub fn kind(&self) -> SamplerKind {
         self.kind
     }
 
+    /// The seed it was built with.
     pub fn seed(&self) -> u64 {
         self.seed
     }

@@ -40,7 +40,9 @@ pub fn sobol_u32(index: u32, dim: u32) -> u32 {
 /// The two halves of a scramble seed: an addend and an odd multiplier.
 #[derive(Clone, Copy, Debug)]
 pub struct Scramble<U> {
+    /// Addend of the permutation (added again later with its halves swapped).
     pub add: U,
+    /// Odd multiplier of the permutation, so that multiplying stays a bijection.
     pub mul: U,
 }
 

@@ -11,6 +11,7 @@ pub fn sample_tent(u: f32) -> f32 {
     lanes::sample_tent(u)
 }
 
+/// Density of [`sample_tent`] at `x`; zero outside [-1, 1].
 #[inline]
 pub fn tent_pdf(x: f32) -> f32 {
     (1.0 - x.abs()).max(0.0)
@@ -49,6 +50,7 @@ pub fn square_to_uniform_sphere(u: Vec2) -> Vec3 {
     lanes::square_to_uniform_sphere(u.x, u.y).into()
 }
 
+/// Solid-angle density of [`square_to_uniform_sphere`]: 1/(4π).
 #[inline]
 pub fn uniform_sphere_pdf() -> f32 {
     0.25 * FRAC_1_PI
@@ -60,6 +62,7 @@ pub fn square_to_uniform_hemisphere(u: Vec2) -> Vec3 {
     lanes::square_to_uniform_hemisphere(u.x, u.y).into()
 }
 
+/// Solid-angle density of [`square_to_uniform_hemisphere`]: 1/(2π).
 #[inline]
 pub fn uniform_hemisphere_pdf() -> f32 {
     0.5 * FRAC_1_PI

@@ -6,15 +6,22 @@ use std::fmt;
 /// One optional effect of the renderer.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
 pub enum Effect {
+    /// Depth of field: camera rays start on a thin lens.
     Lens,
+    /// Motion blur: moving entities or a camera moving within the shutter.
     Motion,
+    /// Spectral transport at hero wavelengths instead of RGB.
     Spectral,
+    /// Participating media: scattering and absorption between surfaces.
     Media,
+    /// Albedo textures modulate material colours.
     Textures,
+    /// Normal maps perturb shading normals.
     NormalMaps,
 }
 
 impl Effect {
+    /// Every effect, in manifest order.
     pub const ALL: [Effect; 6] = [
         Effect::Lens,
         Effect::Motion,
@@ -24,6 +31,7 @@ impl Effect {
         Effect::NormalMaps,
     ];
 
+    /// The name in the manifest and in messages, e.g. `NORMAL_MAPS`.
     pub fn name(self) -> &'static str {
         match self {
             Effect::Lens => "LENS",
@@ -56,15 +64,18 @@ pub struct Effects {
 }
 
 impl Effects {
+    /// Whether the effect is on.
     pub fn has(&self, e: Effect) -> bool {
         self.on[e as usize]
     }
 
+    /// Turns the effect on or off, with the reason the manifest prints.
     pub fn set(&mut self, e: Effect, on: bool, reason: impl Into<String>) {
         self.on[e as usize] = on;
         self.reasons[e as usize] = reason.into();
     }
 
+    /// Why the effect is on or off.
     pub fn reason(&self, e: Effect) -> &str {
         &self.reasons[e as usize]
     }

@@ -18,15 +18,22 @@ const MAX_W: usize = 16;
 /// [`super::LightSample`] of each lane; lanes outside `has` hold no sample.
 #[derive(Clone, Copy)]
 pub struct LaneLightSample<F: Float> {
+    /// Lanes that hold a sample.
     pub has: M<F>,
+    /// Unit direction towards the light.
     pub wi: V3<F>,
+    /// Radiance arriving along `-wi`, linear sRGB.
     pub radiance: V3<F>,
+    /// Solid-angle density including the choice of the light; for a delta light, the choice
+    /// probability.
     pub pdf: F,
+    /// Lanes whose light is a point or spot light.
     pub delta: M<F>,
-    /// Lanes whose sample is a point (area, point and spot lights): the point and its normal
-    /// (zero for point and spot lights).
+    /// Lanes whose sample is a point (area, point and spot lights), held in `q` and `nq`.
     pub at_point: M<F>,
+    /// The sampled point, world space.
     pub q: V3<F>,
+    /// Unit normal at `q` (zero for point and spot lights).
     pub nq: V3<F>,
 }
 

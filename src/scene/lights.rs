@@ -6,6 +6,7 @@ use super::primitives::{PrimKind, Primitives, emitted};
 use crate::sampling::AliasTable;
 use glam::{Vec2, Vec3};
 
+/// One emitter of the light list.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum LightKind {
     /// An emissive primitive (Sphere, Rect or Disk), by primitive index.
@@ -40,19 +41,27 @@ pub enum LightSource {
     /// Area light `prim` of material `material`, its colour modulated by the texture albedo
     /// `tex`.
     Area {
+        /// Material index of the emitter.
         material: u32,
+        /// Texture albedo at the sampled point, if the emitter is textured.
         tex: Option<Vec3>,
+        /// Primitive index of the emitter.
         prim: u32,
     },
     /// Point or spot light `light` (light index), its intensity scaled by falloff / d².
     Point {
+        /// Index in [`Lights::lights`].
         light: u32,
+        /// Spot falloff over squared distance.
         scale: f32,
     },
+    /// The constant environment.
     Environment,
 }
 
+/// The scene's emitters and the alias table that picks among them by power.
 pub struct Lights {
+    /// Every emitter; a light index indexes this.
     pub lights: Vec<LightKind>,
     pub(crate) table: AliasTable,
     /// Index of the environment light, if the environment emits.
@@ -60,6 +69,7 @@ pub struct Lights {
 }
 
 impl Lights {
+    /// Whether the scene has no emitter at all.
     pub fn is_empty(&self) -> bool {
         self.lights.is_empty()
     }
@@ -344,16 +354,23 @@ impl Lights {
 pub enum EquiangularTarget {
     /// Point or spot light `index`, chosen with probability `pmf`.
     Point {
+        /// Index in [`Lights::lights`].
         index: u32,
+        /// The light itself.
         light: crate::components::PointLight,
+        /// Probability of having chosen it.
         pmf: f32,
     },
     /// Point `p` (normal `n`) on area light `prim`, drawn with `density` per unit area
     /// (including the light's selection probability).
     Area {
+        /// Primitive index of the emitter.
         prim: u32,
+        /// The point, world space.
         p: Vec3,
+        /// Unit surface normal at `p`.
         n: Vec3,
+        /// Density per unit area, including the light's selection probability.
         density: f32,
     },
 }

@@ -23,25 +23,36 @@ use glam::Vec3;
 
 /// Everything a render reads, built once per frame from the world.
 pub struct RenderScene {
+    /// Every primitive, material, texture and medium, flattened into arrays.
     pub prims: Primitives,
+    /// Kd-tree over `prims`.
     pub accel: KdTree,
+    /// Emitters and the distribution that picks among them.
     pub lights: Lights,
     /// The camera at the start of the frame's shutter; what every ray uses unless the camera
     /// moves within the shutter.
     pub camera: CameraFrame,
     /// The camera at rest and its path, for cameras that move within the shutter.
     pub base_camera: Camera,
+    /// The camera's keyframe path, if it has one.
     pub camera_path: Option<CameraPath>,
+    /// Whether the camera moves within this frame's shutter.
     pub camera_moves: bool,
     /// The medium around the camera (`primitives::NO_MEDIUM` for none).
     pub camera_medium: u32,
+    /// Frame number being rendered.
     pub frame: u32,
     /// Shutter interval of this frame in scene time (frames): [frame + open, frame + close].
     pub shutter: (f32, f32),
+    /// Radiance of the constant environment, linear sRGB (zero for none).
     pub environment: Vec3,
+    /// What spectral transport evaluates for the environment.
     pub environment_spectrum: crate::spectrum::EmitterSpectrum,
+    /// Which optional effects the kernel runs for this scene.
     pub effects: Effects,
+    /// Render settings, `--set` overrides applied.
     pub settings: RenderSettings,
+    /// Wall-clock seconds the kd-tree build took.
     pub accel_seconds: f64,
 }
 

@@ -20,11 +20,17 @@ type U<F> = <F as Float>::U32;
 /// The closest hit of each lane of a packet; lanes outside `hit` hold no hit.
 #[derive(Clone, Copy)]
 pub struct PacketHit<F: Float> {
+    /// Lanes that hit something.
     pub hit: M<F>,
+    /// Ray parameter of each hit.
     pub t: F,
+    /// Primitive index of each hit.
     pub prim: U<F>,
+    /// The part of the primitive hit (a mesh's triangle), as [`Hit::sub`].
     pub sub: U<F>,
+    /// First hit coordinate, as [`Hit::u`].
     pub u: F,
+    /// Second hit coordinate, as [`Hit::v`].
     pub v: F,
 }
 

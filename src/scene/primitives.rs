@@ -18,25 +18,35 @@ use std::sync::Arc;
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 #[repr(u8)]
 pub enum PrimKind {
+    /// A sphere, in `spheres`.
     Sphere,
+    /// A parallelogram, in `planars`.
     Rect,
+    /// A disk (an ellipse once transformed), in `planars`.
     Disk,
+    /// An oriented box, in `boxes`.
     Box,
+    /// A surface of revolution, in `revolutions`.
     Revolution,
+    /// A triangle mesh, in `meshes`.
     Mesh,
 }
 
 /// An object-space shape placed by an affine transform: rays go in, surface data comes out.
 #[derive(Clone, Debug)]
 pub struct Placed<T> {
+    /// The shape in object space, shared between entities.
     pub shape: Arc<T>,
+    /// Object-to-world transform.
     pub to_world: Affine3A,
+    /// World-to-object transform, the inverse of `to_world`.
     pub to_object: Affine3A,
     /// Inverse transpose of the linear part: carries normals to world space.
     pub normal_matrix: Mat3,
 }
 
 impl<T> Placed<T> {
+    /// `shape` placed by `to_world`.
     pub fn new(shape: Arc<T>, to_world: Affine3A) -> Self {
         let to_object = to_world.inverse();
         Self {
@@ -47,6 +57,7 @@ impl<T> Placed<T> {
         }
     }
 
+    /// A world ray in object space (the same `t` along it).
     #[inline]
     pub fn ray_to_object(&self, ray: &Ray) -> Ray {
         Ray::new(
@@ -55,6 +66,7 @@ impl<T> Placed<T> {
         )
     }
 
+    /// World bounds of the object-space box `b`, from its eight corners.
     pub fn world_bounds(&self, b: &Aabb) -> Aabb {
         let mut w = Aabb::EMPTY;
         for i in 0..8 {
@@ -104,31 +116,45 @@ fn with_rev_stats<R>(f: impl FnOnce(&mut RevolutionStats) -> R) -> R {
 /// What the intersect stage records: small, so the stage streams through memory.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Hit {
+    /// Ray parameter of the hit.
     pub t: f32,
+    /// Primitive index.
     pub prim: u32,
     /// The part of the primitive that was hit (a mesh's triangle).
     pub sub: u32,
+    /// First hit coordinate: a planar shape's α, a mesh's barycentric b1, a revolution's curve
+    /// parameter; for spheres and boxes, 1 if the ray started outside, else 0.
     pub u: f32,
+    /// Second hit coordinate: a planar shape's β, a mesh's b2, a revolution's span parameter.
     pub v: f32,
 }
 
+/// Sentinel of [`Primitives::light`]: the primitive does not emit.
 pub const NO_LIGHT: u32 = u32::MAX;
+/// Sentinel of [`Primitives::motion`]: the primitive does not move.
 pub const NO_MOTION: u32 = u32::MAX;
+/// Sentinel of [`Primitives::texture`]: the primitive has no texture.
 pub const NO_TEXTURE: u32 = u32::MAX;
+/// Sentinel of medium indices: no medium (vacuum).
 pub const NO_MEDIUM: u32 = u32::MAX;
 
 /// Structure-of-arrays primitive store. Index `i` addresses `kind`, `local`, `material`,
 /// `light` and `entity`; `local[i]` indexes the array of its kind.
 #[derive(Default)]
 pub struct Primitives {
+    /// Kind of each primitive.
     pub kind: Vec<PrimKind>,
+    /// Index of each primitive in the array of its kind.
     pub local: Vec<u32>,
+    /// Material index of each primitive, into `materials`.
     pub material: Vec<u32>,
     /// Index into the light list when the primitive emits, else `NO_LIGHT`.
     pub light: Vec<u32>,
+    /// The entity each primitive came from.
     pub entity: Vec<hecs::Entity>,
     /// Index into `motions` for moving primitives, else `NO_MOTION`.
     pub motion: Vec<u32>,
+    /// Rigid motions of the moving primitives.
     pub motions: Vec<RigidMotion>,
     /// The time interval the kd-tree's bounds must cover (frames).
     pub sweep: (f32, f32),
@@ -136,26 +162,37 @@ pub struct Primitives {
     pub medium_inside: Vec<u32>,
     /// The medium around it: the innermost other medium shape holding it, else `NO_MEDIUM`.
     pub medium_outside: Vec<u32>,
+    /// Every medium of the scene.
     pub media: Vec<crate::medium::HomogeneousMedium>,
     /// Index into `textures`, else `NO_TEXTURE`.
     pub texture: Vec<u32>,
+    /// Every texture of the scene.
     pub textures: Vec<Texture>,
+    /// Spheres, world space.
     pub spheres: Vec<Sphere>,
     /// Each sphere's rotation: its UVs turn with it (a globe's longitude).
     pub sphere_rotation: Vec<Quat>,
+    /// Rects and disks, world space.
     pub planars: Vec<Planar>,
+    /// Oriented boxes.
     pub boxes: Vec<OrientedBox>,
+    /// Surfaces of revolution with their placement.
     pub revolutions: Vec<Placed<Revolution>>,
+    /// Triangle meshes with their placement.
     pub meshes: Vec<Placed<TriangleMesh>>,
+    /// Every material of the scene.
     pub materials: Vec<Material>,
+    /// Entity name of each primitive, for messages.
     pub names: Vec<String>,
 }
 
 impl Primitives {
+    /// Number of primitives.
     pub fn len(&self) -> usize {
         self.kind.len()
     }
 
+    /// Whether there are no primitives.
     pub fn is_empty(&self) -> bool {
         self.kind.is_empty()
     }
@@ -187,12 +224,14 @@ impl Primitives {
         }
     }
 
+    /// Primitive `i`'s motion, if it moves.
     #[inline]
     pub fn motion_of(&self, i: u32) -> Option<&RigidMotion> {
         let m = self.motion[i as usize];
         (m != NO_MOTION).then(|| &self.motions[m as usize])
     }
 
+    /// Whether any primitive moves.
     pub fn has_motion(&self) -> bool {
         !self.motions.is_empty()
     }
@@ -529,6 +568,7 @@ impl Primitives {
         }
     }
 
+    /// Primitive `i`'s texture, if it has one.
     #[inline]
     pub fn texture_of(&self, i: u32) -> Option<&Texture> {
         let t = self.texture[i as usize];

@@ -3,31 +3,49 @@
 use std::fmt;
 use std::path::PathBuf;
 
+/// Why a scene could not be loaded.
 #[derive(Debug)]
 pub enum SceneError {
     /// The scene file (or an asset it names) could not be read.
     Io {
+        /// The file that could not be read.
         path: PathBuf,
+        /// The I/O error.
         source: std::io::Error,
     },
     /// Syntax or schema error, with the position RON reported.
     Parse {
+        /// The scene file.
         path: PathBuf,
+        /// Line of the error, 1-based.
         line: usize,
+        /// Column of the error in characters, 1-based.
         col: usize,
+        /// Name of the entity the position falls in, if any.
         entity: Option<String>,
+        /// The innermost field the position falls in, if any.
         field: Option<String>,
+        /// What RON or the schema reported.
         message: String,
     },
     /// A semantic error found while building the world.
     Entity {
+        /// The scene file.
         path: PathBuf,
+        /// Name of the entity.
         entity: String,
+        /// The field at fault.
         field: &'static str,
+        /// What is wrong with it.
         message: String,
     },
     /// A `--set KEY=VALUE` override that does not apply.
-    Override { key: String, message: String },
+    Override {
+        /// The key as given, e.g. `render.spp`.
+        key: String,
+        /// Why the override does not apply.
+        message: String,
+    },
 }
 
 impl fmt::Display for SceneError {

@@ -10,28 +10,46 @@ use std::path::{Path, PathBuf};
 /// Integrator and image settings, after overrides.
 #[derive(Clone, Debug)]
 pub struct RenderSettings {
+    /// Image width in pixels.
     pub width: u32,
+    /// Image height in pixels.
     pub height: u32,
+    /// Samples per pixel.
     pub spp: u32,
+    /// Scattering events after which a path ends.
     pub max_depth: u32,
+    /// Seed of the sampler: different seeds give independent images.
     pub seed: u64,
+    /// Next-event estimation with MIS, or pure path tracing.
     pub light_sampling: schema::LightSampling,
+    /// Scattering events before Russian roulette starts.
     pub rr_depth: u32,
+    /// Exact or Schlick Fresnel term at dielectrics.
     pub fresnel: schema::Fresnel,
+    /// Wavelengths per path in spectral transport: 1 ends the secondary wavelengths at once,
+    /// any other value (up to 4) carries four.
     pub wavelengths: u32,
+    /// Owen-scrambled Sobol or independent samples.
     pub sampler: schema::SamplerChoice,
+    /// In media, also sample distances towards lights (equiangular sampling, MIS).
     pub equiangular: bool,
+    /// The pixel filter camera samples are drawn from.
     pub filter: schema::Filter,
+    /// The lane width the scene asks for (`--simd` overrides it).
     pub simd: crate::simd::SimdChoice,
 }
 
 /// A loaded scene: the world of entities and the resources beside it.
 pub struct LoadedScene {
+    /// The scene file, for messages and to resolve asset paths.
     pub path: PathBuf,
+    /// One entity per scene object, with its components.
     pub world: hecs::World,
+    /// The camera as the file describes it; a path's keyframes override its placement.
     pub camera: Camera,
     /// The animated camera path, when the scene has keyframes.
     pub camera_path: Option<CameraPath>,
+    /// Render settings, overrides applied.
     pub render: RenderSettings,
     /// Radiance of the constant environment (zero when absent).
     pub environment: Vec3,

@@ -99,11 +99,13 @@ fn zero_u<F: Float>() -> F::U32 {
     F::U32::splat(0)
 }
 
+/// sin x, x in radians (accuracy in the module table).
 #[inline(always)]
 pub fn sin<F: Float>(x: F) -> F {
     sin_cos(x).0
 }
 
+/// cos x, x in radians (accuracy in the module table).
 #[inline(always)]
 pub fn cos<F: Float>(x: F) -> F {
     sin_cos(x).1
@@ -236,6 +238,7 @@ fn atan_pos<F: Float>(a: F) -> F {
     ((p * z).mul_add(t, y0_lo) + t) + y0
 }
 
+/// arctan x in (−π/2, π/2).
 #[inline(always)]
 pub fn atan<F: Float>(x: F) -> F {
     atan_pos(x.abs()).copysign(x)
@@ -278,6 +281,7 @@ fn asin_series<F: Float>(a: F, z: F) -> F {
     (a * z).mul_add(p, a)
 }
 
+/// arcsin x in [−π/2, π/2]; NaN outside [−1, 1].
 #[inline(always)]
 pub fn asin<F: Float>(x: F) -> F {
     let a = x.abs();
@@ -292,6 +296,7 @@ pub fn asin<F: Float>(x: F) -> F {
     F::select(a.gt(F::one()), F::splat(f32::NAN), r.copysign(x))
 }
 
+/// arccos x in [0, π]; NaN outside [−1, 1].
 #[inline(always)]
 pub fn acos<F: Float>(x: F) -> F {
     let a = x.abs();

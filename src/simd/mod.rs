@@ -61,14 +61,21 @@ pub trait Mask:
     + BitAndAssign
     + BitOrAssign
 {
+    /// Number of lanes.
     const WIDTH: usize;
+    /// Every lane set to `b`.
     fn splat(b: bool) -> Self;
+    /// Lane `i` set to `f(i)`.
     fn from_fn(f: impl FnMut(usize) -> bool) -> Self;
+    /// Lane `i`.
     fn lane(self, i: usize) -> bool;
     /// Lane `i` in bit `i`.
     fn bits(self) -> u32;
+    /// Whether any lane is set.
     fn any(self) -> bool;
+    /// Whether every lane is set.
     fn all(self) -> bool;
+    /// Whether no lane is set.
     #[inline(always)]
     fn none(self) -> bool {
         !self.any()
@@ -109,12 +116,18 @@ pub trait Float:
     + MulAssign
     + DivAssign
 {
+    /// One boolean per lane, as compares return.
     type Mask: Mask;
+    /// The u32 lane of the same width, for bit patterns and indices.
     type U32: UInt<Mask = Self::Mask, Float = Self>;
+    /// Number of lanes.
     const WIDTH: usize;
 
+    /// Every lane set to `x`.
     fn splat(x: f32) -> Self;
+    /// Lane `i` set to `f(i)`.
     fn from_fn(f: impl FnMut(usize) -> f32) -> Self;
+    /// Lane `i`.
     fn lane(self, i: usize) -> f32;
     /// The first `WIDTH` values of `s`.
     ///
@@ -135,49 +148,66 @@ pub trait Float:
         Self::from_fn(|i| s[idx.lane(i) as usize])
     }
 
+    /// Lanes where `self == o`.
     fn eq(self, o: Self) -> Self::Mask;
+    /// Lanes where `self != o` (true where either is NaN).
     fn ne(self, o: Self) -> Self::Mask;
+    /// Lanes where `self < o`.
     fn lt(self, o: Self) -> Self::Mask;
+    /// Lanes where `self <= o`.
     fn le(self, o: Self) -> Self::Mask;
+    /// Lanes where `self > o`.
     #[inline(always)]
     fn gt(self, o: Self) -> Self::Mask {
         o.lt(self)
     }
+    /// Lanes where `self >= o`.
     #[inline(always)]
     fn ge(self, o: Self) -> Self::Mask {
         o.le(self)
     }
     /// `a` where `m` is set, else `b`.
     fn select(m: Self::Mask, a: Self, b: Self) -> Self;
+    /// Lane-wise minimum under the SSE rule (see the trait docs).
     fn min(self, o: Self) -> Self;
+    /// Lane-wise maximum under the SSE rule (see the trait docs).
     fn max(self, o: Self) -> Self;
     /// `self * b + c` with one rounding.
     fn mul_add(self, b: Self, c: Self) -> Self;
+    /// Correctly rounded square root.
     fn sqrt(self) -> Self;
+    /// `1 / self`, by an exact division.
     #[inline(always)]
     fn recip(self) -> Self {
         Self::splat(1.0) / self
     }
+    /// `self` with the sign bit cleared.
     fn abs(self) -> Self;
     /// The magnitude of `self` with the sign bit of `sign`.
     fn copysign(self, sign: Self) -> Self;
+    /// Round toward negative infinity.
     fn floor(self) -> Self;
     /// Round to nearest, ties to even.
     fn round(self) -> Self;
+    /// The IEEE bit pattern of each lane.
     fn to_bits(self) -> Self::U32;
+    /// Lanes whose IEEE bit patterns are `u`.
     fn from_bits(u: Self::U32) -> Self;
     /// Truncating conversion to i32, as `U32` bits. Out of range and NaN give `i32::MIN`
     /// (the x86 rule; the portable forms match it).
     fn to_i32_bits(self) -> Self::U32;
 
+    /// Every lane 0.
     #[inline(always)]
     fn zero() -> Self {
         Self::splat(0.0)
     }
+    /// Every lane 1.
     #[inline(always)]
     fn one() -> Self {
         Self::splat(1.0)
     }
+    /// Lanes that are NaN.
     #[inline(always)]
     fn is_nan(self) -> Self::Mask {
         self.ne(self)
@@ -222,12 +252,18 @@ pub trait UInt:
     + BitXor<Output = Self>
     + Not<Output = Self>
 {
+    /// One boolean per lane, as compares return.
     type Mask: Mask;
+    /// The f32 lane of the same width.
     type Float: Float<Mask = Self::Mask, U32 = Self>;
+    /// Number of lanes.
     const WIDTH: usize;
 
+    /// Every lane set to `x`.
     fn splat(x: u32) -> Self;
+    /// Lane `i` set to `f(i)`.
     fn from_fn(f: impl FnMut(usize) -> u32) -> Self;
+    /// Lane `i`.
     fn lane(self, i: usize) -> u32;
     /// `s[idx[i]]` in lane `i`.
     ///
@@ -237,8 +273,11 @@ pub trait UInt:
     fn gather(s: &[u32], idx: Self) -> Self {
         Self::from_fn(|i| s[idx.lane(i) as usize])
     }
+    /// Lane-wise sum, modulo 2^32.
     fn wrapping_add(self, o: Self) -> Self;
+    /// Lane-wise difference, modulo 2^32.
     fn wrapping_sub(self, o: Self) -> Self;
+    /// Low 32 bits of the lane-wise product.
     fn wrapping_mul(self, o: Self) -> Self;
     /// Logical shift left by `n` bits (`n < 32`).
     fn shli<const N: u32>(self) -> Self;
@@ -250,15 +289,18 @@ pub trait UInt:
     fn shl_var(self, n: Self) -> Self;
     /// Per-lane logical shift right; counts of 32 or more give 0.
     fn shr_var(self, n: Self) -> Self;
+    /// Lanes where `self == o`.
     fn eq(self, o: Self) -> Self::Mask;
     /// Unsigned less-than.
     fn lt(self, o: Self) -> Self::Mask;
     /// Signed (i32) less-than.
     fn lt_i32(self, o: Self) -> Self::Mask;
+    /// `a` where `m` is set, else `b`.
     fn select(m: Self::Mask, a: Self, b: Self) -> Self;
     /// The lanes read as i32 and converted to f32 (round to nearest even).
     fn i32_to_f32(self) -> Self::Float;
 
+    /// Each lane with its 32 bits in reverse order (as `u32::reverse_bits`).
     #[inline(always)]
     fn reverse_bits(self) -> Self {
         // Swap halves, bytes, nibbles, pairs and bits: five shift-and-mask steps, in every form.
@@ -281,8 +323,11 @@ pub enum SimdChoice {
     /// The widest width this CPU runs natively (see [`Lanes::auto`]).
     #[default]
     Auto,
+    /// 16 lanes (AVX-512F and BW).
     W16,
+    /// 8 lanes (AVX2 + FMA).
     W8,
+    /// 1 lane, scalar code; runs on any CPU.
     W1,
 }
 
@@ -377,8 +422,11 @@ pub struct Lanes(Form);
     "--simd {width} needs {needs}, which this CPU does not have (it runs: {have}); use --simd auto"
 )]
 pub struct SimdUnavailable {
+    /// The width that was asked for.
     pub width: usize,
+    /// The instruction sets that width needs, e.g. `AVX2 and FMA`.
     pub needs: &'static str,
+    /// What this CPU runs instead, as [`Lanes::describe`] gives it.
     pub have: String,
 }
 
@@ -464,6 +512,7 @@ impl Lanes {
         v
     }
 
+    /// Number of lanes: 1, 8 or 16.
     pub fn width(self) -> usize {
         match self.0 {
             Form::Scalar => 1,
@@ -478,6 +527,7 @@ impl Lanes {
         }
     }
 
+    /// Whether this is a native or scalar form rather than a portable one over arrays.
     pub fn is_native(self) -> bool {
         !matches!(self.0, Form::Portable8 | Form::Portable16)
     }
@@ -500,6 +550,7 @@ impl Lanes {
 
 /// A computation generic over the lane type, run by [`dispatch`] at one width.
 pub trait LaneKernel {
+    /// What the kernel returns.
     type Output;
     /// Mark `#[inline(always)]`: see the module docs.
     fn run<F: Float>(self) -> Self::Output;

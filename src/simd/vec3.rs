@@ -5,14 +5,19 @@ use super::Float;
 use glam::Vec3;
 use std::ops::{Add, AddAssign, Mul, MulAssign, Neg, Sub, SubAssign};
 
+/// A vector per lane, stored as one lane value per component.
 #[derive(Clone, Copy, Debug)]
 pub struct V3<F> {
+    /// x component of every lane.
     pub x: F,
+    /// y component of every lane.
     pub y: F,
+    /// z component of every lane.
     pub z: F,
 }
 
 impl<F: Float> V3<F> {
+    /// From its three components.
     #[inline(always)]
     pub fn new(x: F, y: F, z: F) -> Self {
         V3 { x, y, z }
@@ -22,10 +27,12 @@ impl<F: Float> V3<F> {
     pub fn splat(v: Vec3) -> Self {
         V3::new(F::splat(v.x), F::splat(v.y), F::splat(v.z))
     }
+    /// The zero vector in every lane.
     #[inline(always)]
     pub fn zero() -> Self {
         Self::splat(Vec3::ZERO)
     }
+    /// Lane `i` set to `f(i)`.
     #[inline(always)]
     pub fn from_fn(mut f: impl FnMut(usize) -> Vec3) -> Self {
         let mut x = [0.0f32; 16];
@@ -37,14 +44,17 @@ impl<F: Float> V3<F> {
         }
         V3::new(F::load(&x), F::load(&y), F::load(&z))
     }
+    /// The vector in lane `i`.
     #[inline(always)]
     pub fn lane(self, i: usize) -> Vec3 {
         Vec3::new(self.x.lane(i), self.y.lane(i), self.z.lane(i))
     }
+    /// Dot product per lane (fused).
     #[inline(always)]
     pub fn dot(self, o: Self) -> F {
         self.x.mul_add(o.x, self.y.mul_add(o.y, self.z * o.z))
     }
+    /// Cross product per lane.
     #[inline(always)]
     pub fn cross(self, o: Self) -> Self {
         V3::new(
@@ -53,10 +63,12 @@ impl<F: Float> V3<F> {
             self.x * o.y - self.y * o.x,
         )
     }
+    /// Squared length per lane.
     #[inline(always)]
     pub fn length_squared(self) -> F {
         self.dot(self)
     }
+    /// Length per lane.
     #[inline(always)]
     pub fn length(self) -> F {
         self.dot(self).sqrt()
@@ -80,6 +92,7 @@ impl<F: Float> V3<F> {
             self.z.mul_add(s, o.z),
         )
     }
+    /// `a` in lanes where `m` is set, else `b`.
     #[inline(always)]
     pub fn select(m: F::Mask, a: Self, b: Self) -> Self {
         V3::new(
@@ -88,6 +101,7 @@ impl<F: Float> V3<F> {
             F::select(m, a.z, b.z),
         )
     }
+    /// Largest component per lane.
     #[inline(always)]
     pub fn max_element(self) -> F {
         self.x.max(self.y).max(self.z)

@@ -149,7 +149,9 @@ pub enum EmitterSpectrum {
     /// The emitter's RGB value, upsampled as an [`RgbIlluminant`](super::RgbIlluminant)
     /// when transport is spectral.
     Rgb,
+    /// A black body at a temperature (see [`Blackbody`]).
     Blackbody(Blackbody),
+    /// A named standard illuminant (see [`Illuminant`]).
     Illuminant(Illuminant),
 }
 

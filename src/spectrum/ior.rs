@@ -10,12 +10,27 @@ pub enum IorModel {
     /// The same index at every wavelength (no dispersion).
     Constant(f32),
     /// Cauchy's two-term formula n = a + b/λ², `b` in µm².
-    Cauchy { a: f32, b: f32 },
+    Cauchy {
+        /// Index approached at long wavelengths.
+        a: f32,
+        /// Dispersion coefficient, µm².
+        b: f32,
+    },
     /// Three-term Sellmeier formula n² = 1 + Σ bᵢλ²/(λ² − cᵢ), `c` in µm².
-    Sellmeier { b: [f32; 3], c: [f32; 3] },
+    Sellmeier {
+        /// Oscillator strengths bᵢ (dimensionless).
+        b: [f32; 3],
+        /// Resonance wavelengths squared cᵢ, µm².
+        c: [f32; 3],
+    },
     /// Four-term Sellmeier formula, the form in which some fits (water,
     /// Daimon & Masumura 2007) are published.
-    Sellmeier4 { b: [f32; 4], c: [f32; 4] },
+    Sellmeier4 {
+        /// Oscillator strengths bᵢ (dimensionless).
+        b: [f32; 4],
+        /// Resonance wavelengths squared cᵢ, µm².
+        c: [f32; 4],
+    },
 }
 
 impl IorModel {

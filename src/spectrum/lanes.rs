@@ -13,11 +13,14 @@ use crate::simd::{Float, Mask, UInt, V3};
 /// Each lane's [`Wavelengths`]: `lambda[k]` and `pdf[k]` hold wavelength `k` of every lane.
 #[derive(Clone, Copy, Debug)]
 pub struct LaneWavelengths<F> {
+    /// Wavelengths, nm; `lambda[0]` is the hero.
     pub lambda: [F; N_LAMBDA],
+    /// Density of each wavelength, 1/nm.
     pub pdf: [F; N_LAMBDA],
 }
 
 impl<F: Float> LaneWavelengths<F> {
+    /// Every wavelength and pdf 0 (a placeholder to be overwritten).
     #[inline(always)]
     pub fn zero() -> Self {
         LaneWavelengths {
@@ -51,6 +54,7 @@ impl<F: Float> LaneWavelengths<F> {
         }
     }
 
+    /// `a` in lanes where `m` is set, else `b`.
     #[inline(always)]
     pub fn select(m: F::Mask, a: Self, b: Self) -> Self {
         let mut w = a;

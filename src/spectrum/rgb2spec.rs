@@ -662,8 +662,8 @@ pub fn table_cell(channel: usize, k: usize, j: usize, i: usize) -> RgbSigmoid {
     RgbSigmoid::from_coeffs(table().line(channel, j, i)[k])
 }
 
-/// Fits every cell of the table now rather than as colours need them (see [`Table`]), e.g.
-/// to time the whole fit.
+/// Fits every cell of the table now rather than as colours need them (the table is otherwise
+/// fitted lazily, one line of cells at a time), e.g. to time the whole fit.
 pub fn init_table() {
     const R: usize = TABLE_RES;
     let t = table();

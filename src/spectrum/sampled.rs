@@ -329,9 +329,13 @@ pub trait Channels:
     + Div<f32, Output = Self>
     + DivAssign<f32>
 {
+    /// Zero in every channel.
     const ZERO: Self;
+    /// One in every channel.
     const ONE: Self;
+    /// Largest channel value.
     fn max_element(self) -> f32;
+    /// Whether every channel is finite.
     fn is_finite(self) -> bool;
 }
 

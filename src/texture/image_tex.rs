@@ -22,9 +22,12 @@ use crate::imageio::{FilmError, read_image, srgb_decode};
 ///   or u = 1 gives the edge column, with no seam.
 #[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Hash, Deserialize, Serialize)]
 pub enum Wrap {
+    /// The image tiles the plane.
     #[default]
     Repeat,
+    /// The edge texels extend outwards.
     Clamp,
+    /// The image tiles with every other copy flipped.
     Mirror,
 }
 
@@ -47,17 +50,39 @@ pub const TEXTURE_EXTENSIONS: &str = ".png, .jpg, .jpeg, .hdr, .exr";
 /// Why a texture could not be loaded. Every message names the file.
 #[derive(Debug, thiserror::Error)]
 pub enum TextureError {
+    /// The file does not exist.
     #[error("texture '{}' not found", .path.display())]
-    Missing { path: PathBuf },
+    Missing {
+        /// The texture file.
+        path: PathBuf,
+    },
+    /// The file exists but could not be read.
     #[error("cannot read texture '{}': {}", .path.display(), io_reason(.error))]
-    Unreadable { path: PathBuf, error: io::Error },
+    Unreadable {
+        /// The texture file.
+        path: PathBuf,
+        /// The I/O error.
+        error: io::Error,
+    },
+    /// The file's extension is not one of [`TEXTURE_EXTENSIONS`].
     #[error(
         "texture '{}': unsupported image format ({found}); supported extensions: {}",
         .path.display(), TEXTURE_EXTENSIONS
     )]
-    UnsupportedFormat { path: PathBuf, found: String },
+    UnsupportedFormat {
+        /// The texture file.
+        path: PathBuf,
+        /// The extension found, quoted, or `no extension`.
+        found: String,
+    },
+    /// The file was read but its contents are not a valid image.
     #[error("cannot decode texture '{}': {message}", .path.display())]
-    Decode { path: PathBuf, message: String },
+    Decode {
+        /// The texture file.
+        path: PathBuf,
+        /// What the decoder reported.
+        message: String,
+    },
 }
 
 impl TextureError {
@@ -241,10 +266,12 @@ impl TexImage {
         })
     }
 
+    /// Width in texels.
     pub fn width(&self) -> u32 {
         self.width
     }
 
+    /// Height in texels.
     pub fn height(&self) -> u32 {
         self.height
     }
@@ -338,6 +365,7 @@ pub struct TextureCache {
 }
 
 impl TextureCache {
+    /// An empty cache.
     pub fn new() -> Self {
         Self::default()
     }
@@ -362,6 +390,7 @@ impl TextureCache {
         self.images.len()
     }
 
+    /// Whether no image has been loaded.
     pub fn is_empty(&self) -> bool {
         self.images.is_empty()
     }

@@ -24,9 +24,18 @@ pub use procedural::{Bricks, Checker, Wood};
 /// Reflectance as a function of uv, linear RGB.
 #[derive(Clone, Debug, PartialEq)]
 pub enum AlbedoTexture {
-    Image { image: Arc<TexImage>, wrap: Wrap },
+    /// An image, sampled bilinearly.
+    Image {
+        /// The image's texels, linear RGB.
+        image: Arc<TexImage>,
+        /// How uv outside [0, 1]² is folded back.
+        wrap: Wrap,
+    },
+    /// A checkerboard of two colours.
     Checker(Checker),
+    /// Bricks in running bond with mortar joints.
     Bricks(Bricks),
+    /// Wood rings with noise.
     Wood(Wood),
 }
 
@@ -75,14 +84,19 @@ impl AlbedoTexture {
 pub enum NormalMap {
     /// A tangent-space normal map, stored linearly with components encoded as `2c − 1`.
     Image {
+        /// The map's texels.
         image: Arc<TexImage>,
         /// Negate y, for maps authored with +y along −v (DirectX convention).
         flip_y: bool,
+        /// How uv outside [0, 1]² is folded back.
         wrap: Wrap,
     },
     /// Bumps from the albedo's [`AlbedoTexture::height`], scaled by `strength` (negative
     /// inverts the relief).
-    FromHeight { strength: f32 },
+    FromHeight {
+        /// Relief scale; negative inverts it.
+        strength: f32,
+    },
 }
 
 impl NormalMap {
@@ -130,9 +144,13 @@ impl NormalMap {
 /// An entity's texture: optional albedo and normal source plus the uv mapping.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Texture {
+    /// Reflectance, if the texture sets it.
     pub albedo: Option<AlbedoTexture>,
+    /// Shading-normal perturbation, if any.
     pub normal_map: Option<NormalMap>,
+    /// uv multiplier: `uv' = uv * scale + offset`.
     pub scale: Vec2,
+    /// uv offset, added after `scale`.
     pub offset: Vec2,
 }
 

@@ -25,8 +25,11 @@ fn smoothstep(e0: f32, e1: f32, x: f32) -> f32 {
 /// Squares of side `size`; the square touching the origin from above-right is `a`.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Checker {
+    /// Colour of the square touching the origin from above-right, linear RGB.
     pub a: Vec3,
+    /// Colour of the other squares, linear RGB.
     pub b: Vec3,
+    /// Side of a square, uv units.
     pub size: f32,
 }
 
@@ -41,6 +44,7 @@ impl Checker {
         sum != 1.0
     }
 
+    /// Linear RGB at `uv`.
     #[inline]
     pub fn eval(&self, uv: Vec2) -> Vec3 {
         if self.is_a(uv) { self.a } else { self.b }
@@ -64,9 +68,13 @@ impl Checker {
 /// v = k·size.y, so the origin lies in mortar and (size.x/2, size.y/2) is a brick centre.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Bricks {
+    /// Brick colour, linear RGB.
     pub brick: Vec3,
+    /// Mortar colour, linear RGB.
     pub mortar: Vec3,
+    /// Pitch of the pattern (brick plus one joint) along u and v, uv units.
     pub size: Vec2,
+    /// Width of the mortar joints, uv units.
     pub joint: f32,
 }
 
@@ -87,11 +95,13 @@ impl Bricks {
         fu.min(w - fu).min(fv.min(h - fv))
     }
 
+    /// True where `uv` lies in a mortar joint.
     #[inline]
     pub fn is_mortar(&self, uv: Vec2) -> bool {
         self.joint_distance(uv) < 0.5 * self.joint
     }
 
+    /// Linear RGB at `uv`.
     #[inline]
     pub fn eval(&self, uv: Vec2) -> Vec3 {
         if self.is_mortar(uv) {
@@ -123,7 +133,9 @@ impl Bricks {
 /// of each ring) is harder and stands slightly proud of the softer earlywood.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Wood {
+    /// Earlywood colour, linear RGB.
     pub light: Vec3,
+    /// Latewood colour, linear RGB.
     pub dark: Vec3,
     /// Rings per uv unit across the grain (along v).
     pub rings: f32,
@@ -150,11 +162,13 @@ impl Wood {
         if l.is_finite() { l } else { 0.0 }
     }
 
+    /// Linear RGB at `uv`: earlywood blended towards latewood.
     #[inline]
     pub fn eval(&self, uv: Vec2) -> Vec3 {
         self.light.lerp(self.dark, self.latewood(uv))
     }
 
+    /// Relief in uv units: latewood ridges stand proud of earlywood.
     #[inline]
     pub fn height(&self, uv: Vec2) -> f32 {
         self.latewood(uv) * RIDGE / self.rings
