@@ -73,6 +73,37 @@ fn a_point_on_the_focal_plane_images_to_a_point() {
 }
 
 #[test]
+fn a_point_off_axis_on_the_focal_plane_images_to_a_point() {
+    // The focal surface of a thin lens is the plane at `focus_distance` in front of the lens,
+    // not a sphere of that radius: a point 30° off axis on the plane (11.5 units away) must be
+    // as sharp as one on the axis. Were the focus a sphere, a lens of radius 4 would spread
+    // it over a disc of about 3 px radius.
+    let (f, a) = (10.0f32, 4.0f32);
+    let x = f * 30f32.to_radians().tan();
+    let img = image(&format!(
+        r#"Scene(
+    render: (width: 96, height: 96, spp: 4096, max_depth: 0, seed: 5),
+    camera: (position: (0.0, 0.0, 0.0), look_at: (0.0, 0.0, -1.0), fov_y: 90.0,
+             lens: (aperture_radius: {a}, focus_distance: {f})),
+    entities: [ (name: "point", shape: Sphere(center: ({x}, 0.0, -{f}), radius: 0.08),
+                 material: Light(emission: Rgb(1.0, 1.0, 1.0))) ],
+)"#
+    ));
+    let (_, cx, cy, vx, vy) = moments(&img);
+    // Pinhole image of the point: x_ndc = tan 30° / tan 45°, 48 px per unit.
+    let expect_x = 48.0 + f64::from(30f32.to_radians().tan()) * 48.0;
+    assert!(
+        (cx - expect_x).abs() < 0.1 && (cy - 48.0).abs() < 0.1,
+        "centre {cx} {cy}, expected {expect_x} 48"
+    );
+    // The tent filter gives at most 1/4 per axis (t(1 − t) for a point at t within a pixel),
+    // the emitter's own image (0.44 px radius along x, 0.38 along y) under 0.05: at most
+    // 0.77 px together.
+    let rms = (vx + vy).sqrt();
+    assert!(rms <= 1.0, "spread {rms} px (vx {vx}, vy {vy})");
+}
+
+#[test]
 fn a_point_off_the_focal_plane_images_to_the_circle_of_confusion() {
     let (a, f, z) = (0.25f64, 10.0f64, 5.0f64);
     let img = point_image(z as f32, a as f32, f as f32);

@@ -113,16 +113,19 @@ pub fn camera_rays<F: Float, const MOTION: bool>(
     let two = F::splat(2.0);
     let sx = two * fx / F::splat(s.width as f32) - F::one();
     let sy = F::one() - two * fy / F::splat(s.height as f32);
-    let dir = cam.forward + cam.right * (sx * cam.half_x) + cam.up * (sy * cam.half_y);
-    let dir = dir.normalize();
+    // Unit length along `forward` (the film plane at distance 1), so `focus_distance` times
+    // it lands on the focal plane.
+    let film = cam.forward + cam.right * (sx * cam.half_x) + cam.up * (sy * cam.half_y);
+    let dir = film.normalize();
     if ctx.lens {
         let c = &scene.camera;
         let (lx, ly) = sampler.get_2d_lanes::<F>(pixel, index, U::<F>::splat(DIM_LENS));
         let (px, py) = lens_point_lanes(lx, ly, c.blades);
         let a = F::splat(c.aperture_radius);
         let o = cam.origin + cam.right * (px * a) + cam.up * (py * a);
-        // `dir` has unit length along `forward`, so this is the point on the focal plane.
-        let focus = cam.origin + dir * F::splat(c.focus_distance);
+        // The thin lens focuses a plane, not a sphere: every lens point's ray through this
+        // pixel meets the pinhole ray where it crosses the plane at `focus_distance`.
+        let focus = cam.origin + film * F::splat(c.focus_distance);
         CameraRays {
             o,
             d: (focus - o).normalize(),
