@@ -129,6 +129,41 @@ fn negative_radius_names_entity_field_and_range() {
 }
 
 #[test]
+fn refusals_say_what_to_write_instead() {
+    let d = tempfile::tempdir().unwrap();
+    // A colour written as a bare tuple: RON alone says only "Expected identifier".
+    let scene = write(
+        d.path(),
+        "t.ron",
+        &GOOD.replace("albedo: Rgb(0.5, 0.5, 0.5)", "albedo: (0.5, 0.5, 0.5)"),
+    );
+    let err = fails(&["info", scene.to_str().unwrap()]);
+    assert!(
+        err.contains("t.ron:7:") && err.contains("Rgb(0.8, 0.3, 0.2)"),
+        "{err}"
+    );
+    // Two or three wavelengths would carry four.
+    let scene = write(
+        d.path(),
+        "w.ron",
+        &GOOD.replace("spp: 2)", "spp: 2, integrator: (wavelengths: 3))"),
+    );
+    let err = fails(&["info", scene.to_str().unwrap()]);
+    assert!(err.contains("w.ron:2:") && err.contains("1 or 4"), "{err}");
+    // A point light's motion would be ignored, so it is refused.
+    let scene = write(
+        d.path(),
+        "p.ron",
+        &GOOD.replace(
+            "    ],",
+            "        (name: \"bulb\", light: Point(position: (0.0, 2.0, 0.0), intensity: Rgb(1.0, 1.0, 1.0)),\n         motion: (velocity: (1.0, 0.0, 0.0))),\n    ],",
+        ),
+    );
+    let err = fails(&["info", scene.to_str().unwrap()]);
+    assert!(err.contains("\"bulb\"") && err.contains("motion"), "{err}");
+}
+
+#[test]
 fn zero_size_image_is_refused() {
     let d = tempfile::tempdir().unwrap();
     let scene = write(d.path(), "s.ron", &GOOD.replace("width: 8", "width: 0"));
@@ -263,6 +298,17 @@ fn set_reaches_entity_fields_by_name_and_index() {
     ]);
     assert!(
         err.contains("entities[99] does not exist: the file has 8 entities"),
+        "{err}"
+    );
+    // A field added to a material that has no such field is the --set's fault, not the file's.
+    let err = fails(&[
+        "info",
+        cornell.to_str().unwrap(),
+        "--set",
+        r#"entities["light"].material.albedo=Rgb(0.5, 0.5, 0.5)"#,
+    ]);
+    assert!(
+        err.contains(r#"--set entities["light"].material.albedo"#) && err.contains("albedo"),
         "{err}"
     );
 }

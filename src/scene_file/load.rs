@@ -127,13 +127,22 @@ pub fn parse(text: &str, path: &Path) -> Result<schema::Scene, SceneError> {
         let pos = e.span.start;
         let at = offset_of(text, pos.line, pos.col);
         let (entity, field) = context_at(text, at);
+        let mut message = e.code.to_string();
+        // A bare tuple where an enum is expected (`albedo: (0.8, 0.3, 0.2)`): RON's own words
+        // do not say what is missing.
+        if matches!(e.code, ron::Error::ExpectedIdentifier) && text[at..].starts_with('(') {
+            message.push_str(
+                ": name the kind of value before its parenthesis, e.g. `Rgb(0.8, 0.3, 0.2)` \
+                 for a colour (docs/scene-format.md lists them)",
+            );
+        }
         SceneError::Parse {
             path: path.to_path_buf(),
             line: pos.line,
             col: pos.col,
             entity,
             field,
-            message: e.code.to_string(),
+            message,
         }
     })
 }
@@ -364,6 +373,22 @@ fn build_world(scene: schema::Scene, path: &Path, hash: u64) -> Result<LoadedSce
                     "light",
                     "a point or spot light has no shape or material; use a Light material for an area light".into(),
                 ));
+            }
+            // Refused rather than ignored: a point light neither moves, fills a medium nor
+            // carries a texture.
+            for (field, present) in [
+                ("motion", e.motion.is_some()),
+                ("medium", e.medium.is_some()),
+                ("texture", e.texture.is_some()),
+            ] {
+                if present {
+                    return Err(err(
+                        field,
+                        format!(
+                            "a point or spot light takes no {field}: it is placed by its position (and transform) alone"
+                        ),
+                    ));
+                }
             }
             let light = match l {
                 schema::LightSpec::Point {

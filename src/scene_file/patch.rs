@@ -23,8 +23,8 @@ pub fn is_entity_path(key: &str) -> bool {
     key.starts_with("entities[")
 }
 
-/// Applies `key = value` to `text`: the new text and the byte range the value occupies in
-/// it. Errors say which step of the path fails.
+/// Applies `key = value` to `text`: the new text and the byte range the edit occupies in it
+/// (the value, or `name: value` for an added field). Errors say which step of the path fails.
 pub fn apply(text: &str, key: &str, value: &str) -> Result<(String, Range<usize>), String> {
     let steps = parse_path(key)?;
     let b = text.as_bytes();
@@ -58,8 +58,9 @@ pub fn apply(text: &str, key: &str, value: &str) -> Result<(String, Range<usize>
                         let insert = format!("{name}: ");
                         let pos = body.start;
                         let new = format!("{}{insert}{value}, {}", &text[..pos], &text[pos..]);
-                        let start = pos + insert.len();
-                        return Ok((new, start..start + value.len()));
+                        // The span covers the added name too: a struct without that field
+                        // is refused at the name, and the error must still blame `--set`.
+                        return Ok((new, pos..pos + insert.len() + value.len()));
                     }
                     None => return Err(format!("{at} has no field '{name}' to set a field of")),
                 }
@@ -364,7 +365,7 @@ mod tests {
 
     fn set(key: &str, value: &str) -> Result<String, String> {
         let (text, span) = apply(SCENE, key, value)?;
-        assert_eq!(&text[span], value);
+        assert!(text[span].ends_with(value));
         Ok(text)
     }
 

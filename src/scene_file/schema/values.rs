@@ -67,8 +67,9 @@ checked_number!(
     #[derive(Default)]
     Blades(u32, "u32"), |x: u32| x == 0 || (3..=64).contains(&x), "0 (round) or 3..=64");
 checked_number!(
-    /// Wavelengths carried per path in spectral mode.
-    Wavelengths(u32, "u32"), |x: u32| (1..=4).contains(&x), "1..=4");
+    /// Wavelengths carried per path in spectral mode: 4 (hero wavelength sampling) or 1. Two
+    /// or three would silently carry four, so they are refused.
+    Wavelengths(u32, "u32"), |x: u32| x == 1 || x == 4, "1 or 4 wavelengths per path");
 
 /// `scale: 2.0` or `scale: (1.0, 2.0, 1.0)`; every component non-zero and finite.
 #[derive(Clone, Copy, Debug, PartialEq)]
