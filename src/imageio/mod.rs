@@ -28,8 +28,11 @@ pub use srgb::{srgb_decode, srgb_encode};
 /// Linear-light RGB image, row-major, top row first.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Image {
+    /// Width in pixels.
     pub width: u32,
+    /// Height in pixels.
     pub height: u32,
+    /// Linear RGB, row-major, top row first, `width × height` entries.
     pub pixels: Vec<[f32; 3]>,
 }
 
@@ -68,8 +71,13 @@ impl Image {
 /// mismatched ones refused.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub struct ImageMeta {
+    /// Samples per pixel averaged into the image (`prism:spp`).
     pub spp: u32,
+    /// Index of the first of those samples per pixel (`prism:sample_offset`): the image holds
+    /// samples `sample_offset .. sample_offset + spp`, so merged parts must not overlap.
     pub sample_offset: u64,
+    /// Hash of the scene text and every override except the sample count
+    /// (`prism:scene_hash`): parts with different hashes come from different renders.
     pub scene_hash: u64,
     /// The lane width the samples were computed at (`prism:simd`): widths round differently,
     /// so parts of one image must agree on it. `None` when unknown.
@@ -90,10 +98,12 @@ pub const ATTR_SCENE_HASH: &str = "prism:scene_hash";
 /// The lane width, in decimal (optional: images from before it existed lack it).
 pub const ATTR_SIMD: &str = "prism:simd";
 
-/// Output formats `write_image` can produce.
+/// Output formats [`write_image`] can produce.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ImageFormat {
+    /// 8-bit sRGB preview, clamped after [`PngOptions::exposure`]; no metadata.
     Png,
+    /// 32-bit float linear RGB with [`ImageMeta`] in the header: exact, mergeable.
     Exr,
 }
 
@@ -111,7 +121,7 @@ impl ImageFormat {
     }
 }
 
-/// What `read_image` accepts; wider than [`ImageFormat`] because references
+/// What [`read_image`] accepts; wider than [`ImageFormat`] because references
 /// may come from other renderers or photo tools.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 enum ReadFormat {

@@ -3,17 +3,25 @@
 use super::{Blades, FovY, NonNegative, Positive, V3};
 use serde::Deserialize;
 
+/// A pinhole or thin-lens camera; the image's right is `forward × up`.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Camera {
+    /// Eye point (lens centre), world space.
     pub position: V3,
+    /// Point the camera looks at; must differ from `position`.
     pub look_at: V3,
+    /// Up direction; need not be orthogonal to the view, must not be parallel to it. Default
+    /// (0, 1, 0).
     #[serde(default = "default_up")]
     pub up: V3,
+    /// Vertical field of view in degrees, in (0, 180); default 40.
     #[serde(default = "default_fov")]
     pub fov_y: FovY,
+    /// Thin lens for depth of field; absent, a pinhole.
     #[serde(default)]
     pub lens: Option<Lens>,
+    /// When the shutter is open within each frame; absent, the whole frame (0 to 1).
     #[serde(default)]
     pub shutter: Option<Shutter>,
 }
@@ -25,19 +33,27 @@ fn default_fov() -> FovY {
     FovY(40.0)
 }
 
+/// A thin lens: everything at `focus_distance` is sharp, the rest blurs with the aperture.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Lens {
+    /// Lens radius in scene units, >= 0; 0 is a pinhole.
     pub aperture_radius: NonNegative,
+    /// Distance from the eye to the plane in focus, scene units, > 0.
     pub focus_distance: Positive,
+    /// Aperture shape: 0 (default) round, 3..=64 a polygon with that many sides.
     #[serde(default)]
     pub blades: Blades,
 }
 
+/// The open part of each frame, for motion blur: frame f covers [f, f + 1), and the shutter
+/// is open over [f + open, f + close], with `0 <= open <= close <= 1`.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields, try_from = "ShutterSpec")]
 pub struct Shutter {
+    /// When the shutter opens, as a fraction of the frame.
     pub open: f32,
+    /// When the shutter closes, as a fraction of the frame; `open == close` freezes motion.
     pub close: f32,
 }
 

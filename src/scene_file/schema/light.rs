@@ -9,15 +9,25 @@ use serde::Deserialize;
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields, try_from = "LightSpecRaw")]
 pub enum LightSpec {
+    /// Emits equally in every direction.
     Point {
+        /// Where the light is, object space (the entity's `transform` applies).
         position: V3,
+        /// Radiant intensity.
         intensity: Emission,
     },
+    /// Emits into a cone about `direction`.
     Spot {
+        /// Where the light is, object space (the entity's `transform` applies).
         position: V3,
+        /// Axis of the cone, object space; any non-zero length.
         direction: V3,
+        /// Half-angle of the cone in degrees, in (0, 90].
         cone: f32,
+        /// Width of the soft edge inside the cone in degrees, in [0, `cone`]; default 0 (a
+        /// hard edge).
         falloff: f32,
+        /// Radiant intensity within `cone - falloff` of the axis.
         intensity: Emission,
     },
 }
@@ -85,5 +95,6 @@ impl TryFrom<LightSpecRaw> for LightSpec {
 /// Background radiance seen by escaping rays.
 #[derive(Clone, Debug, Deserialize)]
 pub enum Environment {
+    /// The same radiance from every direction.
     Constant(Emission),
 }

@@ -2,20 +2,31 @@
 
 use serde::{Deserialize, Serialize};
 
+/// How a surface scatters or emits light. Surfaces scatter on both sides.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum Material {
+    /// A Lambertian reflector.
     Diffuse {
+        /// Reflectance, every channel in [0, 1].
         albedo: Albedo,
     },
+    /// A perfect specular reflector.
     Mirror {
+        /// Reflectance, every channel in [0, 1].
         tint: Albedo,
     },
+    /// Smooth glass: Fresnel-weighted specular reflection and refraction.
     Dielectric {
+        /// Index of refraction inside the surface; outside it is 1.
         ior: Ior,
     },
+    /// An area light on a Sphere, Rect or Disk; it emits and does not scatter.
     Light {
+        /// Emitted radiance.
         emission: Emission,
+        /// Emit from both sides instead of only the side the normal faces (outward on a
+        /// sphere); default `false`.
         #[serde(default)]
         two_sided: bool,
     },
@@ -120,10 +131,12 @@ impl TryFrom<IorSpec> for Ior {
 /// Linear sRGB colour.
 #[derive(Clone, Copy, Debug, Deserialize, Serialize, PartialEq)]
 pub enum Color {
+    /// Red, green and blue components.
     Rgb(f32, f32, f32),
 }
 
 impl Color {
+    /// The components as a vector (r, g, b).
     pub fn vec(&self) -> glam::Vec3 {
         let Color::Rgb(r, g, b) = *self;
         glam::Vec3::new(r, g, b)
@@ -152,15 +165,21 @@ impl TryFrom<Color> for Albedo {
 
 /// Emitted radiance (or a point light's intensity): `Rgb(r, g, b)`, `Blackbody(kelvin:, scale:)`
 /// or `Illuminant(spectrum: D65 | Sun, scale:)`; the spectral ones are normalised to luminance
-/// Y = `scale`. `rgb` is the linear sRGB colour of the emission either way.
+/// Y = `scale`. `rgb` is the linear sRGB colour of the emission either way. Checked: `Rgb`
+/// channels finite and >= 0, `kelvin` in 500..=100000, `scale` finite and >= 0.
 #[derive(Clone, Copy, Debug, Deserialize)]
 #[serde(try_from = "EmissionSpec")]
 pub struct Emission {
+    /// The emission as linear sRGB, what RGB transport and power-based light selection use;
+    /// every channel >= 0.
     pub rgb: glam::Vec3,
+    /// What spectral transport evaluates instead: `rgb` upsampled, a black body or an
+    /// illuminant.
     pub spectrum: crate::spectrum::EmitterSpectrum,
 }
 
 impl Emission {
+    /// The linear sRGB colour, [`Emission::rgb`].
     pub fn vec(&self) -> glam::Vec3 {
         self.rgb
     }

@@ -8,8 +8,11 @@ use serde::Deserialize;
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields, try_from = "MediumRaw")]
 pub struct MediumSpec {
+    /// Absorption coefficient per scene unit, every channel finite and >= 0.
     pub sigma_a: Color,
+    /// Scattering coefficient per scene unit, every channel finite and >= 0.
     pub sigma_s: Color,
+    /// Henyey–Greenstein asymmetry in (-1, 1): > 0 scatters forward, 0 (default) evenly.
     pub g: f32,
 }
 

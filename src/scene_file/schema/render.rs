@@ -3,28 +3,36 @@
 use super::{ImageDim, Positive, Spp, Wavelengths};
 use serde::{Deserialize, Serialize};
 
+/// The `render:` settings; every field is optional.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Render {
+    /// Image width in pixels, 1..=65536; default 640.
     #[serde(default = "default_width")]
     pub width: ImageDim,
+    /// Image height in pixels, 1..=65536; default 480.
     #[serde(default = "default_height")]
     pub height: ImageDim,
+    /// Samples per pixel, >= 1; default 64.
     #[serde(default = "default_spp")]
     pub spp: Spp,
+    /// Scattering events after which a path ends, counted as pbrt counts them; default 12.
     #[serde(default = "default_max_depth")]
     pub max_depth: u32,
+    /// Sampler seed: different seeds give independent images; default 1.
     #[serde(default = "default_seed")]
     pub seed: u64,
+    /// The integrator's options; each has a default.
     #[serde(default)]
     pub integrator: IntegratorSettings,
-    /// The pixel filter camera samples are drawn from.
+    /// The pixel filter camera samples are drawn from; default `Tent`.
     #[serde(default)]
     pub filter: Filter,
-    /// The lane width of the kernel: `"auto"`, 16, 8 or 1 (`--simd` overrides it).
+    /// The lane width of the kernel: `"auto"` (default), 16, 8 or 1 (`--simd` overrides it).
     #[serde(default)]
     pub simd: crate::simd::SimdChoice,
-    /// Overrides every surface of revolution's Newton tolerance (for accuracy studies).
+    /// Overrides every surface of revolution's Newton tolerance (for accuracy studies); > 0,
+    /// absent by default.
     #[serde(default)]
     pub newton_tolerance: Option<Positive>,
 }
@@ -61,21 +69,28 @@ impl Default for Render {
     }
 }
 
+/// `render: (integrator: (..))`: how paths are sampled; every field is optional.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct IntegratorSettings {
+    /// How emitters are found; default `Nee`.
     #[serde(default)]
     pub light_sampling: LightSampling,
+    /// Scattering events before Russian roulette may end a path; default 5.
     #[serde(default = "default_rr_depth")]
     pub rr_depth: u32,
+    /// The Fresnel term at dielectrics; default `Exact`.
     #[serde(default)]
     pub fresnel: Fresnel,
+    /// Wavelengths per path in spectral transport, 1..=4; default 4. 1 traces a single
+    /// wavelength, any other value four.
     #[serde(default = "default_wavelengths")]
     pub wavelengths: Wavelengths,
+    /// Where sample values come from; default `Sobol`.
     #[serde(default)]
     pub sampler: SamplerChoice,
     /// In media, also sample scattering distances towards point, spot and area lights
-    /// (equiangular sampling, combined with free-flight sampling by MIS).
+    /// (equiangular sampling, combined with free-flight sampling by MIS); default `true`.
     #[serde(default = "default_true")]
     pub equiangular: bool,
 }
@@ -108,8 +123,11 @@ impl Default for IntegratorSettings {
 /// found only by chance).
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
 pub enum LightSampling {
+    /// Next-event estimation: a light sample at every scattering event, weighted by MIS
+    /// against the BSDF sample.
     #[default]
     Nee,
+    /// Pure path tracing: emitters contribute only when a path hits them.
     Path,
 }
 
@@ -118,21 +136,29 @@ pub enum LightSampling {
 /// with a box use, for equal-error comparisons).
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
 pub enum Filter {
+    /// A tent of radius one pixel.
     #[default]
     Tent,
+    /// A box one pixel wide.
     Box,
 }
 
+/// The Fresnel reflectance at dielectric interfaces.
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
 pub enum Fresnel {
+    /// The unpolarised Fresnel equations.
     #[default]
     Exact,
+    /// Schlick's approximation, for comparison with renderers that use it.
     Schlick,
 }
 
+/// The sample sequence camera, light and BSDF samples are drawn from.
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
 pub enum SamplerChoice {
+    /// Owen-scrambled Sobol points: lower error at the same sample count.
     #[default]
     Sobol,
+    /// Independent uniform random numbers, as a baseline.
     Independent,
 }

@@ -3,34 +3,55 @@
 use super::{Positive, Scale, V3};
 use serde::Deserialize;
 
+/// An entity's surface, in object space (the entity's `transform` places it).
 #[derive(Clone, Debug, Deserialize)]
 #[serde(try_from = "ShapeSpec")]
 pub enum Shape {
+    /// A sphere; it takes a uniform scale only.
     Sphere {
+        /// Centre, object space.
         center: V3,
+        /// Radius in scene units, > 0.
         radius: Positive,
     },
+    /// A parallelogram spanning `center ± u ± v`, facing `normalize(u × v)`.
     Rect {
+        /// Centre, object space.
         center: V3,
+        /// Half of one side; non-zero.
         u: V3,
+        /// Half of the other side; non-zero and not parallel to `u`.
         v: V3,
     },
+    /// A flat disk.
     Disk {
+        /// Centre, object space.
         center: V3,
+        /// The side the disk faces; any non-zero length.
         normal: V3,
+        /// Radius in scene units, > 0.
         radius: Positive,
     },
+    /// An axis-aligned box (before the transform).
     Box {
+        /// The lowest corner; below `max` on every axis.
         min: V3,
+        /// The highest corner.
         max: V3,
     },
     /// A triangle mesh from an OBJ or PLY file, relative to the scene file.
     Mesh {
+        /// Path of the `.obj` or `.ply` file, relative to the scene file's directory; not
+        /// blank.
         path: String,
     },
     /// A cubic B-spline profile (radius, height) revolved about the local y axis.
     Revolution {
+        /// Control points (radius, height) of a clamped uniform cubic B-spline: at least 4,
+        /// finite, radii >= 0 and not all 0.
         profile: Vec<(f32, f32)>,
+        /// Newton convergence threshold in the curve parameter, in (0, 0.1); default 1e-6
+        /// (`render.newton_tolerance` overrides it).
         tolerance: Option<f32>,
     },
 }
@@ -135,10 +156,13 @@ impl TryFrom<ShapeSpec> for Shape {
 #[derive(Clone, Debug, Default, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Transform {
+    /// Offset in scene units; default zero.
     #[serde(default)]
     pub translate: Option<V3>,
+    /// Rotation about the x, y and z axes in degrees, applied x first; default zero.
     #[serde(default)]
     pub rotate: Option<V3>,
+    /// Per-axis scale, or one number for all three; finite and non-zero, default 1.
     #[serde(default)]
     pub scale: Option<Scale>,
 }

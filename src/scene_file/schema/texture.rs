@@ -34,9 +34,13 @@ use crate::texture::{AlbedoTexture, NormalMap, Texture};
 #[derive(Clone, Debug, Deserialize)]
 #[serde(try_from = "TextureSpecFields")]
 pub struct TextureSpec {
+    /// Multiplies the material's colour (Diffuse albedo, Mirror tint, Light emission).
     pub albedo: Option<AlbedoSpec>,
+    /// Perturbs the shading normal.
     pub normal_map: Option<NormalMapSpec>,
+    /// Multiplies surface uv before lookup; default (1, 1).
     pub scale: Option<UvScale>,
+    /// Added to surface uv after `scale`; default (0, 0).
     pub offset: Option<UvOffset>,
 }
 
@@ -89,28 +93,46 @@ impl TryFrom<TextureSpecFields> for TextureSpec {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum AlbedoSpec {
+    /// An image file, sampled bilinearly.
     Image {
+        /// The image file, relative to the scene file's directory.
         path: ImagePath,
+        /// How uv outside [0, 1]² folds back; default `Repeat`.
         #[serde(default)]
         wrap: Wrap,
     },
+    /// A checkerboard of two reflectances.
     Checker {
+        /// Reflectance of the square touching the uv origin from above-right, channels in
+        /// [0, 1].
         a: Albedo,
+        /// Reflectance of the other squares, channels in [0, 1].
         b: Albedo,
+        /// Side of a square in uv units, > 0.
         size: Positive,
     },
+    /// Bricks in running bond with mortar joints.
     Bricks {
+        /// Reflectance of the bricks, channels in [0, 1].
         brick: Albedo,
+        /// Reflectance of the joints, channels in [0, 1].
         mortar: Albedo,
+        /// Brick pitch (width, height) in uv units, joint included; both > 0.
         size: PositivePair,
+        /// Mortar width as a fraction of the shorter side of `size`, in (0, 0.5); default 0.1.
         #[serde(default = "default_joint")]
         joint: JointFraction,
     },
+    /// Growth rings with the grain along u.
     Wood {
+        /// Reflectance of the earlywood, channels in [0, 1].
         light: Albedo,
+        /// Reflectance of the latewood, channels in [0, 1].
         dark: Albedo,
+        /// Growth rings per uv unit across the grain (along v), > 0; default 8.
         #[serde(default = "default_rings")]
         rings: Positive,
+        /// Distortion of the rings in ring widths, >= 0; default 0.5.
         #[serde(default = "default_noise")]
         noise: NonNegative,
     },
@@ -138,14 +160,20 @@ fn default_noise() -> NonNegative {
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub enum NormalMapSpec {
+    /// A tangent-space normal map image.
     Image {
+        /// The image file, relative to the scene file's directory.
         path: ImagePath,
+        /// Negate the green component, for DirectX-style maps; default `false`.
         #[serde(default)]
         flip_y: bool,
+        /// How uv outside [0, 1]² folds back; default `Repeat`.
         #[serde(default)]
         wrap: Wrap,
     },
+    /// Bumps from the albedo texture's relief height.
     FromHeight {
+        /// Relief scale, any finite number (negative inverts the relief); default 1.
         #[serde(default = "default_strength")]
         strength: Strength,
     },
@@ -283,6 +311,8 @@ impl TextureSpec {
 }
 
 impl AlbedoSpec {
+    /// Builds the runtime albedo, loading an image through `cache` (sRGB-decoded) from
+    /// `base_dir` joined with its path.
     pub fn build(
         &self,
         base_dir: &Path,
@@ -328,6 +358,8 @@ impl AlbedoSpec {
 }
 
 impl NormalMapSpec {
+    /// Builds the runtime normal map, loading an image through `cache` (read linearly) from
+    /// `base_dir` joined with its path.
     pub fn build(
         &self,
         base_dir: &Path,

@@ -10,6 +10,7 @@ use std::fmt;
 pub struct V3(pub [f32; 3]);
 
 impl V3 {
+    /// The vector as glam's type.
     pub fn vec(&self) -> glam::Vec3 {
         glam::Vec3::from_array(self.0)
     }
