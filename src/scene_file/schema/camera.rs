@@ -33,7 +33,8 @@ fn default_fov() -> FovY {
     FovY(40.0)
 }
 
-/// A thin lens: everything at `focus_distance` is sharp, the rest blurs with the aperture.
+/// A thin lens: the plane `focus_distance` in front of it is sharp, the rest blurs with the
+/// aperture.
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct Lens {

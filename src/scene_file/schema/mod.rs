@@ -1,5 +1,5 @@
-//! serde types of the RON scene file: its public contract (summarised in the README's "Scene
-//! files").
+//! serde types of the RON scene file: its public contract, documented for users field by field
+//! in `docs/scene-format.md`.
 //!
 //! Value ranges are checked here, during deserialisation (`#[serde(try_from)]` newtypes), so
 //! that a bad value is reported with the line and column where it stands. Parts of the schema

@@ -82,8 +82,8 @@ pub struct IntegratorSettings {
     /// The Fresnel term at dielectrics; default `Exact`.
     #[serde(default)]
     pub fresnel: Fresnel,
-    /// Wavelengths per path in spectral transport, 1..=4; default 4. 1 traces a single
-    /// wavelength, any other value four.
+    /// Wavelengths per path in spectral transport: 4 (the default, hero wavelength sampling)
+    /// or 1.
     #[serde(default = "default_wavelengths")]
     pub wavelengths: Wavelengths,
     /// Where sample values come from; default `Sobol`.
