@@ -29,25 +29,22 @@ pub fn parse_shard(s: &str) -> Result<(u32, u32), String> {
 
 /// Reads the shard index from the environment variable `var` (as batch schedulers set it).
 pub fn shard_from_env(var: &str, count: Option<u32>) -> Result<(u32, u32), CliError> {
-    let n = count.ok_or_else(|| {
-        CliError(format!(
-            "--shard-from-env {var} needs --shard-count N (the number of shards)"
-        ))
+    let n = count.ok_or_else(|| CliError::ShardCountMissing { var: var.into() })?;
+    let v = std::env::var(var).map_err(|error| CliError::ShardEnvUnset {
+        var: var.into(),
+        error,
     })?;
-    let v = std::env::var(var).map_err(|_| {
-        CliError(format!(
-            "--shard-from-env: environment variable {var} is not set"
-        ))
-    })?;
-    let i: u32 = v.trim().parse().map_err(|_| {
-        CliError(format!(
-            "--shard-from-env: {var}='{v}' is not a shard index (a whole number)"
-        ))
+    let i: u32 = v.trim().parse().map_err(|error| CliError::ShardIndex {
+        var: var.into(),
+        value: v.clone(),
+        error,
     })?;
     if n == 0 || i >= n {
-        return Err(CliError(format!(
-            "--shard-from-env: {var}={i} is outside 0..{n} (--shard-count {n})"
-        )));
+        return Err(CliError::ShardOutOfRange {
+            var: var.into(),
+            index: i,
+            count: n,
+        });
     }
     Ok((i, n))
 }
@@ -57,46 +54,38 @@ pub fn shard_from_env(var: &str, count: Option<u32>) -> Result<(u32, u32), CliEr
 /// disjoint sample ranges that together form one contiguous range.
 pub fn merge(parts: &[PathBuf], out: &Path) -> Result<(u32, u64), CliError> {
     if parts.is_empty() {
-        return Err(CliError("merge needs at least one part".into()));
+        return Err(CliError::MergeNoParts);
     }
     let mut loaded: Vec<(PathBuf, Image, ImageMeta)> = Vec::with_capacity(parts.len());
     for p in parts {
         let (img, meta) = film::read_image(p)?;
-        let meta = meta.ok_or_else(|| {
-            CliError(format!(
-                "'{}' has no prism:spp / prism:sample_offset / prism:scene_hash header: only EXR files rendered by prism can be merged",
-                p.display()
-            ))
-        })?;
+        let meta = meta.ok_or_else(|| CliError::MergeNoHeader(p.clone()))?;
         if let Some((p0, i0, m0)) = loaded.first() {
             if m0.scene_hash != meta.scene_hash {
-                return Err(CliError(format!(
-                    "'{}' and '{}' come from different scenes or settings (scene hash {:#018x} vs {:#018x})",
-                    p0.display(),
-                    p.display(),
-                    m0.scene_hash,
-                    meta.scene_hash
-                )));
+                return Err(CliError::MergeScenes {
+                    first: p0.clone(),
+                    other: p.clone(),
+                    first_hash: m0.scene_hash,
+                    other_hash: meta.scene_hash,
+                });
             }
             if let (Some(w0), Some(w)) = (m0.simd, meta.simd)
                 && w0 != w
             {
-                return Err(CliError(format!(
-                    "'{}' was rendered at lane width {w0} but '{}' at {w}: widths round differently, so render every part with the same --simd",
-                    p0.display(),
-                    p.display(),
-                )));
+                return Err(CliError::MergeWidths {
+                    first: p0.clone(),
+                    other: p.clone(),
+                    first_width: w0,
+                    other_width: w,
+                });
             }
             if (i0.width, i0.height) != (img.width, img.height) {
-                return Err(CliError(format!(
-                    "'{}' is {}x{} but '{}' is {}x{}",
-                    p0.display(),
-                    i0.width,
-                    i0.height,
-                    p.display(),
-                    img.width,
-                    img.height
-                )));
+                return Err(CliError::MergeSizes {
+                    first: p0.clone(),
+                    first_size: (i0.width, i0.height),
+                    other: p.clone(),
+                    other_size: (img.width, img.height),
+                });
             }
         }
         loaded.push((p.clone(), img, meta));
@@ -109,23 +98,23 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<(u32, u64), CliError> {
     for w in ranges.windows(2) {
         let ((a0, a1, pa), (b0, b1, pb)) = (w[0], w[1]);
         if b0 < a1 {
-            return Err(CliError(format!(
-                "'{}' (samples {a0}..{a1}) and '{}' (samples {b0}..{b1}) overlap: they would count the same samples twice",
-                pa.display(),
-                pb.display()
-            )));
+            return Err(CliError::MergeOverlap {
+                first: pa.to_path_buf(),
+                first_samples: (a0, a1),
+                second: pb.to_path_buf(),
+                second_samples: (b0, b1),
+            });
         }
         if b0 > a1 {
-            return Err(CliError(format!(
-                "samples {a1}..{b0} are missing between '{}' and '{}'",
-                pa.display(),
-                pb.display()
-            )));
+            return Err(CliError::MergeGap {
+                missing: (a1, b0),
+                before: pa.to_path_buf(),
+                after: pb.to_path_buf(),
+            });
         }
     }
     let total: u64 = loaded.iter().map(|(_, _, m)| m.spp as u64).sum();
-    let total_u32 = u32::try_from(total)
-        .map_err(|_| CliError(format!("merged sample count {total} is too large")))?;
+    let total_u32 = u32::try_from(total).map_err(|_| CliError::MergeTooLarge(total))?;
     let (w, h) = (loaded[0].1.width, loaded[0].1.height);
     let mut sums = vec![[0.0f64; 3]; (w * h) as usize];
     for (_, img, m) in &loaded {
@@ -159,6 +148,19 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<(u32, u64), CliError> {
     };
     film::write_image(out, &merged, &meta, &PngOptions::default())?;
     Ok((total_u32, ranges[0].0))
+}
+
+/// `prism merge`: [`merge`], then a line on stderr naming the result.
+pub(super) fn run_merge(parts: &[PathBuf], output: &Path) -> Result<(), CliError> {
+    let (spp, offset) = merge(parts, output)?;
+    eprintln!(
+        "wrote {} ({} parts, samples {}..{})",
+        output.display(),
+        parts.len(),
+        offset,
+        offset + spp as u64
+    );
+    Ok(())
 }
 
 #[cfg(test)]

@@ -60,10 +60,7 @@ pub fn check_template(template: &Path) -> Result<(), CliError> {
         .map(|n| n.to_string_lossy().to_string())
         .unwrap_or_default();
     if !name.contains('#') {
-        return Err(CliError(format!(
-            "with --frames, the output '{}' needs a run of '#' for the frame number, e.g. out/frame_####.png",
-            template.display()
-        )));
+        return Err(CliError::FrameTemplate(template.to_path_buf()));
     }
     Ok(())
 }
@@ -89,7 +86,10 @@ pub fn write_gif(frames: &[PathBuf], fps: u32, out: &Path) -> Result<(), CliErro
     {
         let mut enc = GifEncoder::new_with_speed(&mut bytes, 10);
         enc.set_repeat(Repeat::Infinite)
-            .map_err(|e| CliError(format!("cannot write '{}': {e}", out.display())))?;
+            .map_err(|error| CliError::Gif {
+                path: out.to_path_buf(),
+                error,
+            })?;
         for f in frames {
             let (img, _) = crate::film::read_image(f)?;
             let mut rgba = RgbaImage::new(img.width, img.height);
@@ -100,7 +100,10 @@ pub fn write_gif(frames: &[PathBuf], fps: u32, out: &Path) -> Result<(), CliErro
             }
             let delay = Delay::from_numer_denom_ms(1000, fps.max(1));
             enc.encode_frame(Frame::from_parts(rgba, 0, 0, delay))
-                .map_err(|e| CliError(format!("cannot write '{}': {e}", out.display())))?;
+                .map_err(|error| CliError::Gif {
+                    path: out.to_path_buf(),
+                    error,
+                })?;
         }
     }
     crate::film::write_atomic(out, &bytes)?;

@@ -1,0 +1,204 @@
+//! Why a command failed: one variant per cause, each printed as one readable line after
+//! `error: `.
+
+use crate::film::FilmError;
+use crate::scene::Effect;
+use crate::scene_file::SceneError;
+use crate::simd::SimdUnavailable;
+use std::path::PathBuf;
+
+/// A command-line failure. Its `Display` is the whole message, one line.
+#[derive(Debug, thiserror::Error)]
+pub enum CliError {
+    /// The scene file, an asset it names or a `--set` override could not be loaded.
+    #[error(transparent)]
+    Scene(#[from] SceneError),
+    /// An image could not be read, written or compared, or its name has no known format.
+    #[error(transparent)]
+    Film(#[from] FilmError),
+    /// The lane width asked for does not run on this CPU.
+    #[error(transparent)]
+    Simd(#[from] SimdUnavailable),
+    /// `--budget` is not a positive number of seconds.
+    #[error("--budget must be a positive number of seconds, got {0}")]
+    Budget(f64),
+    /// `--time-limit` is not a positive number of seconds.
+    #[error("--time-limit must be a positive number of seconds, got {0}")]
+    TimeLimit(f64),
+    /// `--threads 0`.
+    #[error("--threads must be at least 1")]
+    NoThreads,
+    /// The pool of worker threads could not be started.
+    #[error("cannot start worker threads: {0}")]
+    ThreadPool(#[source] rayon::ThreadPoolBuildError),
+    /// `--force` names no effect.
+    #[error("--force {0}: unknown effect; valid: {names}", names = effect_names())]
+    UnknownEffect(String),
+    /// `--force` names an effect this build does not simulate (the message of
+    /// `Effects::force`).
+    #[error("{0}")]
+    Force(String),
+    /// A study (`converge`, `costs`) failed; the message is the study's own.
+    #[error("{0}")]
+    Report(String),
+    /// The `--frames` output template has no run of `#` for the frame number.
+    #[error(
+        "with --frames, the output '{}' needs a run of '#' for the frame number, e.g. out/frame_####.png",
+        .0.display()
+    )]
+    FrameTemplate(PathBuf),
+    /// The GIF of a frame range could not be encoded.
+    #[error("cannot write '{}': {error}", .path.display())]
+    Gif {
+        /// The GIF being written.
+        path: PathBuf,
+        /// What the encoder reported.
+        #[source]
+        error: image::ImageError,
+    },
+    /// `--shard-from-env` without `--shard-count`.
+    #[error("--shard-from-env {var} needs --shard-count N (the number of shards)")]
+    ShardCountMissing {
+        /// The environment variable named.
+        var: String,
+    },
+    /// The shard index's environment variable is not set (or not Unicode).
+    #[error("--shard-from-env: environment variable {var} is not set")]
+    ShardEnvUnset {
+        /// The environment variable named.
+        var: String,
+        /// Why it could not be read.
+        #[source]
+        error: std::env::VarError,
+    },
+    /// The shard index's environment variable holds no whole number.
+    #[error("--shard-from-env: {var}='{value}' is not a shard index (a whole number)")]
+    ShardIndex {
+        /// The environment variable named.
+        var: String,
+        /// Its value.
+        value: String,
+        /// Why it does not parse.
+        #[source]
+        error: std::num::ParseIntError,
+    },
+    /// The shard index is not below the shard count.
+    #[error("--shard-from-env: {var}={index} is outside 0..{count} (--shard-count {count})")]
+    ShardOutOfRange {
+        /// The environment variable named.
+        var: String,
+        /// The index it holds.
+        index: u32,
+        /// `--shard-count`.
+        count: u32,
+    },
+    /// `merge` without parts.
+    #[error("merge needs at least one part")]
+    MergeNoParts,
+    /// A merge part lacks prism's sample-range header (not an EXR rendered by prism).
+    #[error(
+        "'{}' has no prism:spp / prism:sample_offset / prism:scene_hash header: only EXR files rendered by prism can be merged",
+        .0.display()
+    )]
+    MergeNoHeader(PathBuf),
+    /// Two merge parts come from different scenes or settings.
+    #[error(
+        "'{}' and '{}' come from different scenes or settings (scene hash {first_hash:#018x} vs {other_hash:#018x})",
+        .first.display(),
+        .other.display()
+    )]
+    MergeScenes {
+        /// The first part.
+        first: PathBuf,
+        /// The part that differs from it.
+        other: PathBuf,
+        /// The first part's `prism:scene_hash`.
+        first_hash: u64,
+        /// The other part's `prism:scene_hash`.
+        other_hash: u64,
+    },
+    /// Two merge parts were rendered at different lane widths.
+    #[error(
+        "'{}' was rendered at lane width {first_width} but '{}' at {other_width}: widths round differently, so render every part with the same --simd",
+        .first.display(),
+        .other.display()
+    )]
+    MergeWidths {
+        /// The first part.
+        first: PathBuf,
+        /// The part that differs from it.
+        other: PathBuf,
+        /// The first part's lane width.
+        first_width: u32,
+        /// The other part's lane width.
+        other_width: u32,
+    },
+    /// Two merge parts differ in size.
+    #[error(
+        "'{}' is {}x{} but '{}' is {}x{}",
+        .first.display(),
+        .first_size.0,
+        .first_size.1,
+        .other.display(),
+        .other_size.0,
+        .other_size.1
+    )]
+    MergeSizes {
+        /// The first part.
+        first: PathBuf,
+        /// Its width and height in pixels.
+        first_size: (u32, u32),
+        /// The part that differs from it.
+        other: PathBuf,
+        /// Its width and height in pixels.
+        other_size: (u32, u32),
+    },
+    /// Two merge parts cover some of the same samples.
+    #[error(
+        "'{}' (samples {}..{}) and '{}' (samples {}..{}) overlap: they would count the same samples twice",
+        .first.display(),
+        .first_samples.0,
+        .first_samples.1,
+        .second.display(),
+        .second_samples.0,
+        .second_samples.1
+    )]
+    MergeOverlap {
+        /// The part whose range starts first.
+        first: PathBuf,
+        /// Its sample range, end excluded.
+        first_samples: (u64, u64),
+        /// The part starting inside that range.
+        second: PathBuf,
+        /// Its sample range, end excluded.
+        second_samples: (u64, u64),
+    },
+    /// The merge parts leave a gap in the sample range.
+    #[error(
+        "samples {}..{} are missing between '{}' and '{}'",
+        .missing.0,
+        .missing.1,
+        .before.display(),
+        .after.display()
+    )]
+    MergeGap {
+        /// The samples no part covers, end excluded.
+        missing: (u64, u64),
+        /// The part ending before the gap.
+        before: PathBuf,
+        /// The part starting after it.
+        after: PathBuf,
+    },
+    /// The merged sample count does not fit the image header's u32.
+    #[error("merged sample count {0} is too large")]
+    MergeTooLarge(u64),
+}
+
+/// The names `--force` accepts, comma-separated.
+fn effect_names() -> String {
+    Effect::ALL
+        .iter()
+        .map(|e| e.name().to_ascii_lowercase())
+        .collect::<Vec<_>>()
+        .join(", ")
+}

@@ -1,0 +1,87 @@
+//! `prism info`: what a scene holds and what the renderer will make of it.
+
+use super::CliError;
+use super::args::InfoArgs;
+use super::scene::{load_scene, prepare};
+use crate::integrator;
+
+/// `prism info`: the scene's settings, entities, effects manifest, lights, meshes and
+/// kd-tree, on stdout.
+pub(super) fn info(a: InfoArgs) -> Result<(), CliError> {
+    let scene = load_scene(&a.scene, &a.set, &[])?;
+    let rs = prepare(&scene, &a.force, 0)?;
+    let s = &rs.settings;
+    println!("scene: {}", a.scene.display());
+    println!(
+        "render: {}x{}, {} spp, max depth {}, seed {}, {:?} light sampling, rr depth {}, {:?} Fresnel, {:?} sampler, {:?} filter",
+        s.width,
+        s.height,
+        s.spp,
+        s.max_depth,
+        s.seed,
+        s.light_sampling,
+        s.rr_depth,
+        s.fresnel,
+        s.sampler,
+        s.filter
+    );
+    match crate::simd::Lanes::resolve(s.simd) {
+        Ok(lanes) => println!("simd: {}", integrator::describe_lanes(lanes)),
+        Err(e) => println!("simd: {e}"),
+    }
+    println!("entities: {}", rs.prims.len());
+    for i in 0..rs.prims.len() {
+        let m = rs.prims.materials[rs.prims.material[i] as usize];
+        println!("  \"{}\": {:?}, {m}", rs.prims.names[i], rs.prims.kind[i]);
+    }
+    for w in rs.warnings() {
+        println!("warning: {w}");
+    }
+    println!("effects:");
+    for line in rs.effects.to_string().lines() {
+        println!("  {line}");
+    }
+    let counts = rs
+        .prims
+        .counts()
+        .iter()
+        .map(|(k, n)| format!("{n} {k:?}"))
+        .collect::<Vec<_>>()
+        .join(", ");
+    println!("primitives: {} ({counts})", rs.prims.len());
+    println!(
+        "lights: {} ({} area{})",
+        rs.lights.lights.len(),
+        rs.lights.lights.len() - rs.lights.environment.is_some() as usize,
+        if rs.lights.environment.is_some() {
+            ", environment"
+        } else {
+            ""
+        }
+    );
+    for (i, m) in rs.prims.meshes.iter().enumerate() {
+        let b = m.shape.bounds();
+        println!(
+            "mesh {i}: {}; object bounds ({:.4}, {:.4}, {:.4})..({:.4}, {:.4}, {:.4})",
+            m.shape.stats(),
+            b.min.x,
+            b.min.y,
+            b.min.z,
+            b.max.x,
+            b.max.y,
+            b.max.z
+        );
+    }
+    let k = rs.accel.stats();
+    println!(
+        "kd-tree: {} nodes ({} leaves, {} empty), depth {}, {:.2} primitives per leaf, {} references, built in {:.3} ms",
+        k.nodes,
+        k.leaves,
+        k.empty_leaves,
+        k.max_depth,
+        k.mean_leaf_prims,
+        k.prim_refs,
+        rs.accel_seconds * 1e3
+    );
+    Ok(())
+}

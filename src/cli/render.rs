@@ -1,0 +1,259 @@
+//! `prism render`: stills and frame series (with shards), written atomically, with progress
+//! and statistics on stderr.
+
+use super::args::RenderArgs;
+use super::scene::{force_effects, load_scene, prepare};
+use super::{CliError, farm, frames, progress};
+use crate::film::{self, ImageMeta, PngOptions};
+use crate::integrator::{self, RenderOptions};
+use crate::kdtree::KdParams;
+use crate::scene::RenderScene;
+use crate::scene_file::LoadedScene;
+use std::path::{Path, PathBuf};
+
+/// `prism render`: a still image, or a frame series with `--frames`.
+pub(super) fn render(a: RenderArgs) -> Result<(), CliError> {
+    let mut extra = Vec::new();
+    if let Some(spp) = a.spp {
+        extra.push(("render.spp".to_string(), spp.to_string()));
+    }
+    if let Some(seed) = a.seed {
+        extra.push(("render.seed".to_string(), seed.to_string()));
+    }
+    if let Some((w, h)) = a.size {
+        extra.push(("render.width".to_string(), w.to_string()));
+        extra.push(("render.height".to_string(), h.to_string()));
+    }
+    if let Some(t) = a.time_limit
+        && !(t.is_finite() && t > 0.0)
+    {
+        return Err(CliError::TimeLimit(t));
+    }
+    if a.threads == Some(0) {
+        return Err(CliError::NoThreads);
+    }
+    let scene = load_scene(&a.scene, &a.set, &extra)?;
+    let stem = a
+        .scene
+        .file_stem()
+        .map_or("render".to_string(), |s| s.to_string_lossy().to_string());
+    let pool = rayon::ThreadPoolBuilder::new()
+        .num_threads(a.threads.unwrap_or(0))
+        .build()
+        .map_err(CliError::ThreadPool)?;
+    if let Some(range) = a.frames.clone() {
+        let template = a
+            .output
+            .clone()
+            .unwrap_or_else(|| PathBuf::from(format!("frames/{stem}_####.png")));
+        frames::check_template(&template)?;
+        film::ImageFormat::from_path(&template)?;
+        return render_frames(&a, &scene, &pool, range, &template);
+    }
+    let output = a
+        .output
+        .clone()
+        .unwrap_or_else(|| PathBuf::from(format!("{stem}.png")));
+    // Fail on a bad output name before spending time on the render.
+    film::ImageFormat::from_path(&output)?;
+    let rs = prepare(&scene, &a.force, 0)?;
+    if !a.quiet {
+        for w in rs.warnings() {
+            eprintln!("warning: {w}");
+        }
+    }
+    let out = render_to_file(&a, &scene, &rs, &pool, &output, "")?;
+    if a.stats {
+        print_stats(&rs, &out, &output, pool.current_num_threads());
+    } else if !a.quiet {
+        eprintln!(
+            "wrote {} ({} spp, {:.2} s)",
+            output.display(),
+            out.spp,
+            out.seconds
+        );
+    }
+    Ok(())
+}
+
+/// Renders one frame of a prepared scene and writes it atomically.
+fn render_to_file(
+    a: &RenderArgs,
+    scene: &LoadedScene,
+    rs: &RenderScene,
+    pool: &rayon::ThreadPool,
+    output: &Path,
+    label: &str,
+) -> Result<integrator::RenderOutput, CliError> {
+    let spp = rs.settings.spp;
+    let choice = if a.reference {
+        crate::simd::SimdChoice::W1
+    } else {
+        a.simd.unwrap_or(rs.settings.simd)
+    };
+    let lanes = crate::simd::Lanes::resolve(choice)?;
+    let opts = RenderOptions {
+        sample_offset: a.sample_offset,
+        spp,
+        time_limit: a.time_limit,
+        lanes,
+        monochromatic: None,
+    };
+    let total = rs.settings.width as u64 * rs.settings.height as u64 * spp as u64;
+    let bar = progress::Progress::new(total, a.quiet, label);
+    let out = pool.install(|| integrator::render(rs, &opts, &|n| bar.add(n)));
+    bar.finish();
+    let meta = ImageMeta {
+        spp: out.spp,
+        sample_offset: a.sample_offset as u64,
+        scene_hash: scene.hash,
+        simd: Some(out.lanes.width() as u32),
+    };
+    film::write_image(
+        output,
+        &out.image(),
+        &meta,
+        &PngOptions {
+            exposure: a.exposure,
+        },
+    )?;
+    Ok(out)
+}
+
+/// The frames of `range` (this shard's, with `--shard`) rendered to `template`'s paths, then
+/// the GIF if `--gif` asks for one.
+fn render_frames(
+    a: &RenderArgs,
+    scene: &LoadedScene,
+    pool: &rayon::ThreadPool,
+    range: std::ops::Range<u32>,
+    template: &Path,
+) -> Result<(), CliError> {
+    let list: Vec<u32> = match (&a.shard, &a.shard_from_env) {
+        (Some((i, n)), _) => farm::shard_frames(range.clone(), *i, *n),
+        (None, Some(var)) => {
+            let (i, n) = farm::shard_from_env(var, a.shard_count)?;
+            farm::shard_frames(range.clone(), i, n)
+        }
+        (None, None) => range.clone().collect(),
+    };
+    let n = list.len();
+    let mut rs: Option<RenderScene> = None;
+    let start = std::time::Instant::now();
+    let mut rendered = 0u32;
+    let mut written = Vec::with_capacity(n);
+    for (k, f) in list.iter().copied().enumerate() {
+        let path = frames::frame_path(template, f);
+        written.push(path.clone());
+        if a.resume && path.is_file() {
+            if !a.quiet {
+                eprintln!(
+                    "frame {f} ({}/{n}): {} exists, skipped",
+                    k + 1,
+                    path.display()
+                );
+            }
+            continue;
+        }
+        // The scene is prepared once; later frames move the camera and rebuild the kd-tree
+        // only if primitives move.
+        let scene_for_frame = match rs.as_mut() {
+            None => {
+                let r = rs.insert(prepare(scene, &a.force, f)?);
+                if !a.quiet {
+                    for w in r.warnings() {
+                        eprintln!("warning: {w}");
+                    }
+                }
+                r
+            }
+            Some(r) => {
+                r.set_frame(scene, &KdParams::default(), f);
+                force_effects(r, &a.force)?;
+                r
+            }
+        };
+        scene_for_frame.settings.seed = frames::frame_seed(scene.render.seed, f);
+        let eta = if rendered > 0 {
+            let per = start.elapsed().as_secs_f64() / rendered as f64;
+            format!(", range eta {:.0}s", per * (n - k) as f64)
+        } else {
+            String::new()
+        };
+        let label = format!("frame {f} ({}/{n}{eta})", k + 1);
+        let out = render_to_file(a, scene, scene_for_frame, pool, &path, &label)?;
+        rendered += 1;
+        if a.stats {
+            print_stats(scene_for_frame, &out, &path, pool.current_num_threads());
+        } else if !a.quiet {
+            eprintln!(
+                "frame {f} ({}/{n}): wrote {} ({:.2} s, {:.2} Msamples/s)",
+                k + 1,
+                path.display(),
+                out.seconds,
+                out.stats.samples as f64 / out.seconds.max(1e-9) * 1e-6
+            );
+        }
+    }
+    if let Some(gif) = &a.gif {
+        let fps = scene.camera_path.as_ref().map_or(24, |p| p.fps);
+        frames::write_gif(&written, fps, gif)?;
+        if !a.quiet {
+            eprintln!("wrote {}", gif.display());
+        }
+    }
+    Ok(())
+}
+
+/// The `--stats` report of one render, on stderr.
+fn print_stats(rs: &RenderScene, out: &integrator::RenderOutput, output: &Path, threads: usize) {
+    let s = &out.stats;
+    let sps = s.samples as f64 / out.seconds.max(1e-9);
+    eprintln!(
+        "image: {} ({}x{}, {} spp)",
+        output.display(),
+        out.width,
+        out.height,
+        out.spp
+    );
+    eprintln!("time: {:.3} s on {} threads", out.seconds, threads);
+    eprintln!(
+        "samples: {} ({:.0} samples/s, {:.0} samples/s per thread)",
+        s.samples,
+        sps,
+        sps / threads as f64
+    );
+    eprintln!("dropped samples: {}", s.dropped);
+    eprintln!(
+        "simd: width {}, mean lane occupancy {:.3}",
+        out.lanes.describe(),
+        s.rays as f64 / s.lane_slots.max(1) as f64
+    );
+    eprintln!(
+        "rays: {} closest-hit, {} shadow ({:.2} Mrays/s)",
+        s.rays,
+        s.shadow_rays,
+        (s.rays + s.shadow_rays) as f64 / out.seconds.max(1e-9) * 1e-6
+    );
+    let r = &s.revolution;
+    if r.rays > 0 {
+        eprintln!(
+            "surfaces of revolution: {} rays, {} candidate spans, {} brackets, {} Newton iterations ({:.2} per bracket), {} not converged",
+            r.rays,
+            r.candidate_spans,
+            r.brackets,
+            r.newton_iterations,
+            r.newton_iterations as f64 / r.brackets.max(1) as f64,
+            r.non_converged
+        );
+    }
+    let k = rs.accel.stats();
+    eprintln!(
+        "kd-tree: {} primitives, {} nodes, depth {}, {:.2} primitives per leaf, built in {:.3} ms",
+        k.primitives,
+        k.nodes,
+        k.max_depth,
+        k.mean_leaf_prims,
+        rs.accel_seconds * 1e3
+    );
+}
