@@ -83,6 +83,33 @@ fn info_prints_the_effects_manifest() {
         assert!(s.contains(e), "{e} missing in\n{s}");
     }
     assert!(s.contains("kd-tree:"));
+    assert!(
+        s.contains("environment: Constant(Rgb(0.5, 0.5, 0.5))"),
+        "{s}"
+    );
+}
+
+#[test]
+fn info_prints_lights_and_textures_in_scene_syntax() {
+    let root = Path::new(env!("CARGO_MANIFEST_DIR"));
+    let info = |scene: &str| {
+        let out = prism()
+            .args(["info", root.join(scene).to_str().unwrap()])
+            .output()
+            .unwrap();
+        assert!(out.status.success());
+        String::from_utf8(out.stdout).unwrap()
+    };
+    let s = info("scenes/textures.ron");
+    assert!(
+        s.contains("texture: (albedo: Bricks(brick: Rgb(0.5, 0.15, 0.1), mortar: Rgb(0.8, 0.8, 0.75), size: (0.4, 0.2)"),
+        "{s}"
+    );
+    let s = info("scenes/god_rays.ron");
+    assert!(
+        s.contains("\"spot\": light: Spot(position: (-2.5, 4.6, -1.5)"),
+        "{s}"
+    );
 }
 
 #[test]

@@ -67,3 +67,24 @@ fn the_systems_do_not_depend_on_the_integrator() {
     let found = uses("systems", &["integrator", "cli"]);
     assert!(found.is_empty(), "{found:#?}");
 }
+
+#[test]
+fn image_files_and_textures_stand_apart_from_the_film_and_the_scene_file() {
+    // Image files are a leaf both the film and textures use; textures know neither the film
+    // nor the scene file (the scene file builds textures, not the other way round).
+    let found = uses(
+        "imageio",
+        &[
+            "film",
+            "texture",
+            "scene_file",
+            "scene",
+            "integrator",
+            "cli",
+            "components",
+        ],
+    );
+    assert!(found.is_empty(), "{found:#?}");
+    let found = uses("texture", &["film", "scene_file", "integrator", "cli"]);
+    assert!(found.is_empty(), "{found:#?}");
+}

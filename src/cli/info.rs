@@ -3,6 +3,8 @@
 use super::CliError;
 use super::args::InfoArgs;
 use super::scene::{load_scene, prepare};
+use crate::components::material::EmissionSyntax;
+use crate::components::{Name, PointLight};
 use crate::integrator;
 
 /// `prism info`: the scene's settings, entities, effects manifest, lights, meshes and
@@ -29,10 +31,34 @@ pub(super) fn info(a: InfoArgs) -> Result<(), CliError> {
         Ok(lanes) => println!("simd: {}", integrator::describe_lanes(lanes)),
         Err(e) => println!("simd: {e}"),
     }
-    println!("entities: {}", rs.prims.len());
+    // Point and spot lights are not primitives; file order.
+    let mut points: Vec<_> = scene
+        .world
+        .query::<(hecs::Entity, &Name, &PointLight)>()
+        .iter()
+        .map(|(e, n, l)| (e.id(), n.0.clone(), *l))
+        .collect();
+    points.sort_by_key(|p| p.0);
+    println!("entities: {}", rs.prims.len() + points.len());
     for i in 0..rs.prims.len() {
         let m = rs.prims.materials[rs.prims.material[i] as usize];
-        println!("  \"{}\": {:?}, {m}", rs.prims.names[i], rs.prims.kind[i]);
+        let texture = rs
+            .prims
+            .texture_of(i as u32)
+            .map_or(String::new(), |t| format!(", texture: {t}"));
+        println!(
+            "  \"{}\": {:?}, {m}{texture}",
+            rs.prims.names[i], rs.prims.kind[i]
+        );
+    }
+    for (_, name, light) in points {
+        println!("  \"{name}\": light: {light}");
+    }
+    if scene.environment != glam::Vec3::ZERO {
+        println!(
+            "environment: Constant({})",
+            EmissionSyntax(scene.environment, scene.environment_spectrum)
+        );
     }
     for w in rs.warnings() {
         println!("warning: {w}");

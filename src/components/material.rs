@@ -97,11 +97,39 @@ impl std::fmt::Display for Rgb {
     }
 }
 
+/// An emission (a `Light`'s, a point light's intensity, the environment's) as a scene file
+/// writes it: `Rgb(..)`, or a spectral emitter with the luminance its `scale` gave it.
+pub struct EmissionSyntax(pub Vec3, pub EmitterSpectrum);
+
+impl std::fmt::Display for EmissionSyntax {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        use crate::spectrum::{NamedIlluminant, spectrum_to_xyz};
+        match &self.1 {
+            EmitterSpectrum::Rgb => write!(f, "{}", Rgb(self.0)),
+            EmitterSpectrum::Blackbody(b) => write!(
+                f,
+                "Blackbody(kelvin: {:?}, scale: {:?})",
+                b.kelvin(),
+                significant(spectrum_to_xyz(|l| b.eval(l)).y)
+            ),
+            EmitterSpectrum::Illuminant(i) => write!(
+                f,
+                "Illuminant(spectrum: {}, scale: {:?})",
+                match i.which() {
+                    NamedIlluminant::D65 => "D65",
+                    NamedIlluminant::Sun => "Sun",
+                },
+                significant(spectrum_to_xyz(|l| i.eval(l)).y)
+            ),
+        }
+    }
+}
+
 /// The material as a scene file writes it (`Diffuse(albedo: Rgb(0.7, 0.7, 0.7))`); a preset
 /// IOR by its name, a spectral emitter with the luminance its `scale` gave it.
 impl std::fmt::Display for Material {
     fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
-        use crate::spectrum::{IorPreset, NamedIlluminant, spectrum_to_xyz};
+        use crate::spectrum::IorPreset;
         match self {
             Material::Diffuse { albedo } => write!(f, "Diffuse(albedo: {})", Rgb(*albedo)),
             Material::Mirror { tint } => write!(f, "Mirror(tint: {})", Rgb(*tint)),
@@ -125,22 +153,7 @@ impl std::fmt::Display for Material {
                 two_sided,
                 spectrum,
             } => {
-                let emission = match spectrum {
-                    EmitterSpectrum::Rgb => Rgb(*emission).to_string(),
-                    EmitterSpectrum::Blackbody(b) => format!(
-                        "Blackbody(kelvin: {:?}, scale: {:?})",
-                        b.kelvin(),
-                        significant(spectrum_to_xyz(|l| b.eval(l)).y)
-                    ),
-                    EmitterSpectrum::Illuminant(i) => format!(
-                        "Illuminant(spectrum: {}, scale: {:?})",
-                        match i.which() {
-                            NamedIlluminant::D65 => "D65",
-                            NamedIlluminant::Sun => "Sun",
-                        },
-                        significant(spectrum_to_xyz(|l| i.eval(l)).y)
-                    ),
-                };
+                let emission = EmissionSyntax(*emission, *spectrum);
                 if *two_sided {
                     write!(f, "Light(emission: {emission}, two_sided: true)")
                 } else {

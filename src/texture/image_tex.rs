@@ -122,6 +122,8 @@ pub struct TexImage {
     width: u32,
     height: u32,
     pixels: Vec<[f32; 3]>,
+    /// The file it was read from, for `prism info`; `None` when built in memory.
+    source: Option<PathBuf>,
 }
 
 impl fmt::Debug for TexImage {
@@ -150,6 +152,7 @@ impl TexImage {
             width,
             height,
             pixels,
+            source: None,
         }
     }
 
@@ -263,7 +266,13 @@ impl TexImage {
             width,
             height,
             pixels,
+            source: Some(path.to_path_buf()),
         })
+    }
+
+    /// The file the texels were read from (`None` for an in-memory texture).
+    pub fn source(&self) -> Option<&Path> {
+        self.source.as_deref()
     }
 
     /// Width in texels.

@@ -154,6 +154,86 @@ pub struct Texture {
     pub offset: Vec2,
 }
 
+/// A colour in the scene format's syntax.
+fn rgb(c: Vec3) -> String {
+    format!("Rgb({:?}, {:?}, {:?})", c.x, c.y, c.z)
+}
+
+/// An image's file as `path: "..."` (as resolved from the scene file), or a note for an
+/// in-memory image, which has none.
+fn image_path(image: &TexImage) -> String {
+    match image.source() {
+        Some(p) => format!("path: {:?}", p.display().to_string()),
+        None => "path: \"(in memory)\"".to_owned(),
+    }
+}
+
+/// The texture as a scene file writes it: `(albedo: Checker(..), scale: (2.0, 2.0))`, with
+/// fields at their defaults left out and an image's path as it was resolved.
+impl std::fmt::Display for Texture {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        let mut parts = Vec::new();
+        if let Some(a) = &self.albedo {
+            parts.push(format!(
+                "albedo: {}",
+                match a {
+                    AlbedoTexture::Image { image, wrap } =>
+                        format!("Image({}, wrap: {wrap:?})", image_path(image)),
+                    AlbedoTexture::Checker(c) => format!(
+                        "Checker(a: {}, b: {}, size: {:?})",
+                        rgb(c.a),
+                        rgb(c.b),
+                        c.size
+                    ),
+                    AlbedoTexture::Bricks(b) => format!(
+                        "Bricks(brick: {}, mortar: {}, size: ({:?}, {:?}), joint: {:?})",
+                        rgb(b.brick),
+                        rgb(b.mortar),
+                        b.size.x,
+                        b.size.y,
+                        // The file gives the joint as a fraction of the shorter side.
+                        b.joint / b.size.min_element()
+                    ),
+                    AlbedoTexture::Wood(w) => format!(
+                        "Wood(light: {}, dark: {}, rings: {:?}, noise: {:?})",
+                        rgb(w.light),
+                        rgb(w.dark),
+                        w.rings,
+                        w.noise
+                    ),
+                }
+            ));
+        }
+        if let Some(n) = &self.normal_map {
+            parts.push(format!(
+                "normal_map: {}",
+                match n {
+                    NormalMap::Image {
+                        image,
+                        flip_y,
+                        wrap,
+                    } => format!(
+                        "Image({}, flip_y: {flip_y}, wrap: {wrap:?})",
+                        image_path(image)
+                    ),
+                    NormalMap::FromHeight { strength } =>
+                        format!("FromHeight(strength: {strength:?})"),
+                }
+            ));
+        }
+        if self.scale != Vec2::ONE {
+            parts.push(format!("scale: ({:?}, {:?})", self.scale.x, self.scale.y));
+        }
+        if self.offset != Vec2::ZERO {
+            parts.push(format!(
+                "offset: ({:?}, {:?})",
+                self.offset.x, self.offset.y
+            ));
+        }
+        write!(f, "({})", parts.join(", "))
+    }
+}
+
 impl Texture {
     /// `uv * scale + offset`.
     #[inline]

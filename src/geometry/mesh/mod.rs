@@ -139,10 +139,11 @@ impl TriangleMesh {
             empty_bonus: 0.3,
             // On a dense mesh the SAH never makes a leaf by itself (each split still looks
             // cheaper), so the depth limit shapes the tree and each extra level doubles it.
-            // Leaves are screened four triangles at a time, so a leaf of ~18 costs little
+            // Leaves are screened several triangles at a time, so a leaf of ~18 costs little
             // more than one of ~8: at 8 + 0.8 log2(N) instead of 8 + log2(N) the full bunny's
             // tree has a third of the nodes, builds in 0.6x the time and traces diffuse rays
-            // faster (and at pbrt's 8 + 1.3 log2(N) it had five times the nodes again).
+            // faster (measured with blocks of four; at pbrt's 8 + 1.3 log2(N) it had five
+            // times the nodes again).
             depth_per_doubling: 0.8,
             // Binned down to six references, then exact: the event sweep below 4096 made
             // the full bunny's build about 3x slower for a 1.7% lower SAH cost.

@@ -610,6 +610,41 @@ mod tests {
         assert_eq!(built.map_uv(Vec2::new(1.0, 1.0)), Vec2::new(2.5, -0.75));
     }
 
+    /// `prism info` prints a texture as the scene file writes it: the printed form parses back
+    /// and builds the same texture.
+    #[test]
+    fn built_textures_print_in_scene_syntax() {
+        for text in [
+            "(albedo: Bricks(brick: Rgb(0.5, 0.15, 0.1), mortar: Rgb(0.8, 0.8, 0.75), size: (0.4, 0.2), joint: 0.25),
+              normal_map: FromHeight(strength: 2.0), scale: (2.0, -1.0), offset: (0.5, 0.25))",
+            "(albedo: Checker(a: Rgb(0.9, 0.9, 0.9), b: Rgb(0.1, 0.2, 0.6), size: 0.0625))",
+            "(albedo: Wood(light: Rgb(0.75, 0.55, 0.32), dark: Rgb(0.45, 0.28, 0.14), rings: 3.0, noise: 0.25))",
+        ] {
+            let mut cache = TextureCache::new();
+            let built = parse::<TextureSpec>(text)
+                .unwrap()
+                .build(Path::new("."), &mut cache)
+                .unwrap();
+            let printed = built.to_string();
+            let again = parse::<TextureSpec>(&printed)
+                .unwrap_or_else(|e| panic!("{printed}: {e}"))
+                .build(Path::new("."), &mut cache)
+                .unwrap();
+            // The joint goes through a fraction and back: equal to rounding.
+            match (&built.albedo, &again.albedo) {
+                (Some(AlbedoTexture::Bricks(a)), Some(AlbedoTexture::Bricks(b))) => {
+                    assert!((a.joint - b.joint).abs() < 1e-6, "{printed}");
+                    assert_eq!((a.brick, a.mortar, a.size), (b.brick, b.mortar, b.size));
+                    assert_eq!(
+                        (&built.normal_map, built.scale, built.offset),
+                        (&again.normal_map, again.scale, again.offset)
+                    );
+                }
+                _ => assert_eq!(built, again, "{printed}"),
+            }
+        }
+    }
+
     #[test]
     fn build_reports_missing_image_with_resolved_path() {
         let t: TextureSpec = parse(r#"(albedo: Image(path: "nope/missing.png"))"#).unwrap();
