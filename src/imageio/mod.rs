@@ -22,7 +22,7 @@ use std::path::Path;
 pub use atomic::write_atomic;
 pub use error::FilmError;
 pub(crate) use error::io_reason;
-pub use raster::PngOptions;
+pub use raster::{ColorSpace, PngOptions, decode_raster};
 pub use srgb::{srgb_decode, srgb_encode};
 
 /// Linear-light RGB image, row-major, top row first.
@@ -206,6 +206,6 @@ pub fn read_image(path: &Path) -> Result<(Image, Option<ImageMeta>), FilmError> 
     })?;
     match format {
         ReadFormat::Exr => exr::decode_exr(path, bytes),
-        ReadFormat::Raster(f) => raster::decode_with_image(path, bytes, f).map(|i| (i, None)),
+        ReadFormat::Raster(f) => decode_raster(path, bytes, f, ColorSpace::Srgb).map(|i| (i, None)),
     }
 }

@@ -45,32 +45,68 @@ pub(super) fn encode_png(
     Ok(out)
 }
 
-pub(super) fn decode_with_image(
+/// How the integer samples of a file encode light.
+///
+/// Only 8- and 16-bit sources are affected: EXR and Radiance HDR store linear floats and are
+/// never decoded.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+pub enum ColorSpace {
+    /// Colour images (photos, albedo): samples are sRGB-encoded and decoded with
+    /// [`srgb_decode`].
+    Srgb,
+    /// Data images (normal maps): samples are used as stored, scaled to [0, 1]. Decoding a
+    /// normal map as sRGB would bend every normal.
+    Linear,
+}
+
+/// Decodes PNG, JPEG or Radiance HDR `bytes` (the content decides if it disagrees with
+/// `format`) into linear RGB: 8- and 16-bit samples through `space`, float samples as they
+/// are; alpha dropped, grey replicated. `path` only labels errors.
+pub fn decode_raster(
     path: &Path,
     bytes: Vec<u8>,
     format: image::ImageFormat,
+    space: ColorSpace,
 ) -> Result<Image, FilmError> {
     let decode_err = |message: String| FilmError::Decode {
         path: path.to_path_buf(),
         message,
     };
-    // Trust the content over the extension if they disagree.
-    let reader = image::ImageReader::with_format(Cursor::new(bytes), format)
+    let decoded = image::ImageReader::with_format(Cursor::new(bytes), format)
         .with_guessed_format()
+        .map_err(|e| decode_err(e.to_string()))?
+        .decode()
         .map_err(|e| decode_err(e.to_string()))?;
-    let decoded = reader.decode().map_err(|e| decode_err(e.to_string()))?;
-    // Decide by what was decoded, not by the extension: float sources (HDR)
-    // are linear already, integer ones (PNG, JPEG) are sRGB-encoded.
-    let decode = !matches!(
-        decoded.color(),
-        image::ColorType::Rgb32F | image::ColorType::Rgba32F
-    );
-    let rgb = decoded.into_rgb32f();
-    let (width, height) = rgb.dimensions();
-    let pixels = rgb
-        .pixels()
-        .map(|p| if decode { p.0.map(srgb_decode) } else { p.0 })
-        .collect();
+    let to_linear = |x: f32| match space {
+        ColorSpace::Srgb => srgb_decode(x),
+        ColorSpace::Linear => x,
+    };
+    let color = decoded.color();
+    let bytes_per_sample = color.bytes_per_pixel() / color.channel_count();
+    let (width, height) = (decoded.width(), decoded.height());
+    let pixels: Vec<[f32; 3]> = match bytes_per_sample {
+        1 => {
+            // A table keeps decoding a large photo cheap: 256 powf calls, not millions.
+            let lut: Vec<f32> = (0..=255u8).map(|b| to_linear(b as f32 / 255.0)).collect();
+            decoded
+                .into_rgb8()
+                .pixels()
+                .map(|p| p.0.map(|c| lut[c as usize]))
+                .collect()
+        }
+        2 => {
+            let lut: Vec<f32> = (0..=u16::MAX)
+                .map(|s| to_linear(s as f32 / 65535.0))
+                .collect();
+            decoded
+                .into_rgb16()
+                .pixels()
+                .map(|p| p.0.map(|c| lut[c as usize]))
+                .collect()
+        }
+        // Float sources (Radiance HDR) hold linear radiance already.
+        _ => decoded.into_rgb32f().pixels().map(|p| p.0).collect(),
+    };
     Ok(Image {
         width,
         height,

@@ -3,14 +3,15 @@
 
 use std::collections::HashMap;
 use std::fmt;
-use std::io::{self, Cursor};
+use std::io;
 use std::path::{Path, PathBuf};
 use std::sync::Arc;
 
 use glam::{Vec2, Vec3};
 use serde::{Deserialize, Serialize};
 
-use crate::imageio::{FilmError, read_image, srgb_decode};
+pub use crate::imageio::ColorSpace;
+use crate::imageio::{FilmError, decode_raster, read_image};
 
 /// How texture coordinates outside [0, 1] are folded back onto the image.
 ///
@@ -29,19 +30,6 @@ pub enum Wrap {
     Clamp,
     /// The image tiles with every other copy flipped.
     Mirror,
-}
-
-/// How the integer samples of a file encode light.
-///
-/// Only 8- and 16-bit sources are affected: EXR and Radiance HDR store linear floats and are
-/// never decoded.
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
-pub enum ColorSpace {
-    /// Colour images (albedo): samples are sRGB-encoded and decoded with [`srgb_decode`].
-    Srgb,
-    /// Data images (normal maps): samples are used as stored, scaled to [0, 1]. Decoding a
-    /// normal map as sRGB would bend every normal.
-    Linear,
 }
 
 /// Extensions [`TexImage::load`] accepts.
@@ -209,45 +197,17 @@ impl TexImage {
         format: image::ImageFormat,
         space: ColorSpace,
     ) -> Result<Self, TextureError> {
-        let decode_err = |message: String| TextureError::Decode {
-            path: path.to_path_buf(),
-            message,
-        };
-        // Trust the content over the extension when they disagree.
-        let decoded = image::ImageReader::with_format(Cursor::new(bytes), format)
-            .with_guessed_format()
-            .map_err(|e| decode_err(e.to_string()))?
-            .decode()
-            .map_err(|e| decode_err(e.to_string()))?;
-        let color = decoded.color();
-        let bytes_per_sample = color.bytes_per_pixel() / color.channel_count();
-        let (width, height) = (decoded.width(), decoded.height());
-        let pixels: Vec<[f32; 3]> = match bytes_per_sample {
-            1 => {
-                // A table keeps loading a large photo cheap: 256 powf calls, not millions.
-                let lut: Vec<f32> = (0..=255u8)
-                    .map(|b| to_linear(b as f32 / 255.0, space))
-                    .collect();
-                decoded
-                    .into_rgb8()
-                    .pixels()
-                    .map(|p| p.0.map(|c| lut[c as usize]))
-                    .collect()
-            }
-            2 => {
-                let lut: Vec<f32> = (0..=u16::MAX)
-                    .map(|s| to_linear(s as f32 / 65535.0, space))
-                    .collect();
-                decoded
-                    .into_rgb16()
-                    .pixels()
-                    .map(|p| p.0.map(|c| lut[c as usize]))
-                    .collect()
-            }
-            // Float sources (Radiance HDR) hold linear radiance already.
-            _ => decoded.into_rgb32f().pixels().map(|p| p.0).collect(),
-        };
-        Self::checked(path, width, height, pixels)
+        let img = decode_raster(path, bytes, format, space).map_err(|e| match e {
+            FilmError::Decode { message, .. } => TextureError::Decode {
+                path: path.to_path_buf(),
+                message,
+            },
+            other => TextureError::Decode {
+                path: path.to_path_buf(),
+                message: other.to_string(),
+            },
+        })?;
+        Self::checked(path, img.width, img.height, img.pixels)
     }
 
     fn checked(
@@ -320,13 +280,6 @@ impl TexImage {
     pub fn luminance(&self, uv: Vec2, wrap: Wrap) -> f32 {
         self.bilinear(uv, wrap)
             .dot(Vec3::new(0.2126, 0.7152, 0.0722))
-    }
-}
-
-fn to_linear(encoded: f32, space: ColorSpace) -> f32 {
-    match space {
-        ColorSpace::Srgb => srgb_decode(encoded),
-        ColorSpace::Linear => encoded,
     }
 }
 
