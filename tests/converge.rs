@@ -35,6 +35,13 @@ fn converge_writes_csv_plot_and_summary_with_falling_error() {
     for f in ["converge.csv", "converge.png", "converge.svg", "summary.md"] {
         assert!(d.path().join(f).is_file(), "{f}");
     }
+    // The plot names its scene (plots get copied out of their folders).
+    let stem = scene.file_stem().unwrap().to_string_lossy().into_owned();
+    let svg = std::fs::read_to_string(d.path().join("converge.svg")).unwrap();
+    assert!(
+        svg.contains(&format!("{stem}: error vs render time")),
+        "no title naming {stem}"
+    );
     let csv = std::fs::read_to_string(d.path().join("converge.csv")).unwrap();
     let mut lines = csv.lines();
     assert_eq!(

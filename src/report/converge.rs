@@ -353,7 +353,16 @@ pub fn converge(opts: &ConvergeOptions) -> Result<ConvergeResult, String> {
     film::write_atomic(&opts.out.join("converge.csv"), csv.as_bytes())
         .map_err(|e| e.to_string())?;
     let names: Vec<String> = configs.iter().map(|c| c.name.clone()).collect();
+    // The scene's name in the title: plots get copied out of their folders.
+    let title = format!(
+        "{}: error vs render time",
+        opts.scene.file_stem().map_or_else(
+            || opts.scene.display().to_string(),
+            |s| s.to_string_lossy().into_owned()
+        )
+    );
     super::plot::plot(
+        &title,
         &rows,
         &names,
         &opts.out.join("converge.png"),

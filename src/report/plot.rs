@@ -18,6 +18,7 @@ const COLORS: [RGBColor; 8] = [
 
 fn draw<DB: DrawingBackend>(
     root: DrawingArea<DB, plotters::coord::Shift>,
+    title: &str,
     rows: &[Row],
     names: &[String],
 ) -> Result<(), String>
@@ -39,7 +40,7 @@ where
         .iter()
         .fold((f64::MAX, f64::MIN), |a, &v| (a.0.min(v), a.1.max(v)));
     let mut chart = ChartBuilder::on(&root)
-        .caption("error vs render time", ("sans-serif", 22))
+        .caption(title, ("sans-serif", 22))
         .margin(12)
         .x_label_area_size(40)
         .y_label_area_size(70)
@@ -94,16 +95,24 @@ fn register_font() -> Result<(), String> {
 }
 
 /// Writes the plot as PNG and SVG.
-pub fn plot(rows: &[Row], names: &[String], png: &Path, svg: &Path) -> Result<(), String> {
+pub fn plot(
+    title: &str,
+    rows: &[Row],
+    names: &[String],
+    png: &Path,
+    svg: &Path,
+) -> Result<(), String> {
     register_font()?;
     draw(
         BitMapBackend::new(png, (800, 500)).into_drawing_area(),
+        title,
         rows,
         names,
     )
     .map_err(|e| format!("cannot draw '{}': {e}", png.display()))?;
     draw(
         SVGBackend::new(svg, (800, 500)).into_drawing_area(),
+        title,
         rows,
         names,
     )
