@@ -286,6 +286,8 @@ pub trait Transport: Copy + Send + Sync + 'static {
     fn select_lanes<F: Float>(m: F::Mask, a: Self::Lanes<F>, b: Self::Lanes<F>) -> Self::Lanes<F>;
     /// Lane `i`'s wavelengths.
     fn lane<F: Float>(lam: &Self::Lanes<F>, i: usize) -> Self::Lambda;
+    /// Lane `i`'s wavelengths as a packet of width 1.
+    fn one_lane<F: Float>(lam: &Self::Lanes<F>, i: usize) -> Self::Lanes<f32>;
     /// Throughput of a new path: one on every live wavelength.
     fn initial_beta<F: Float, const N: usize>(lam: &Self::Lanes<F>) -> Chan<F, N>;
     /// The IOR of a dielectric at lane `i`'s hero wavelength, and whether it disperses (so
@@ -392,6 +394,8 @@ impl Transport for Rgb {
     fn select_lanes<F: Float>(_: F::Mask, _: (), _: ()) {}
     #[inline(always)]
     fn lane<F: Float>(_: &(), _: usize) {}
+    #[inline(always)]
+    fn one_lane<F: Float>(_: &(), _: usize) {}
     #[inline(always)]
     fn initial_beta<F: Float, const N: usize>(_: &()) -> Chan<F, N> {
         Chan([F::one(); N])
@@ -563,6 +567,13 @@ impl Transport for Spectral {
     #[inline(always)]
     fn lane<F: Float>(lam: &LaneWavelengths<F>, i: usize) -> Wavelengths {
         lam.lane(i)
+    }
+    #[inline(always)]
+    fn one_lane<F: Float>(lam: &LaneWavelengths<F>, i: usize) -> LaneWavelengths<f32> {
+        LaneWavelengths {
+            lambda: lam.lambda.map(|x| x.lane(i)),
+            pdf: lam.pdf.map(|x| x.lane(i)),
+        }
     }
     #[inline(always)]
     fn initial_beta<F: Float, const N: usize>(lam: &LaneWavelengths<F>) -> Chan<F, N> {
