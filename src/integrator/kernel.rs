@@ -11,7 +11,7 @@
 //! Width 1 is this same code over `f32`: the reference, the oracle every wider
 //! packet is tested against (`tests/simd_widths.rs`).
 
-use super::bsdf::{Chan, LaneChannels};
+use super::bsdf::LaneChannels;
 use super::ctx::Ctx;
 use super::state::{C, M, MAX_W, Paths, U};
 use super::surface::{CLASS_BOUNDARY, CLASS_NONE};
@@ -99,22 +99,12 @@ pub fn render_tile<
         }
         // Finished paths go to the film.
         let ended = started.and_not(st.alive).bits();
-        if T::SPECTRAL {
-            // Spectra become RGB through 24 table lookups per lane: only the lanes that ended
-            // pay for them, one at a time (the same arithmetic at width 1, so the same bits).
-            let mut bits = ended;
-            while bits != 0 {
-                let i = bits.trailing_zeros() as usize;
-                bits &= bits - 1;
-                let l = Chan::<f32, N>(st.l.0.map(|x| x.lane(i)));
-                let rgb = T::to_rgb::<f32, N>(&l, &T::one_lane(&st.lam, i));
-                film.add(st.pixel.lane(i), rgb.lane(0));
-            }
-        } else if ended != 0 {
-            let rgb = T::to_rgb(&st.l, &st.lam);
-            for i in 0..F::WIDTH {
+        if ended != 0 {
+            let mut rgb = [glam::Vec3::ZERO; MAX_W];
+            T::ended_rgb(&st.l, &st.lam, ended, &mut rgb);
+            for (i, rgb) in rgb.iter().enumerate().take(F::WIDTH) {
                 if ended >> i & 1 != 0 {
-                    film.add(st.pixel.lane(i), rgb.lane(i));
+                    film.add(st.pixel.lane(i), *rgb);
                 }
             }
         }

@@ -286,8 +286,6 @@ pub trait Transport: Copy + Send + Sync + 'static {
     fn select_lanes<F: Float>(m: F::Mask, a: Self::Lanes<F>, b: Self::Lanes<F>) -> Self::Lanes<F>;
     /// Lane `i`'s wavelengths.
     fn lane<F: Float>(lam: &Self::Lanes<F>, i: usize) -> Self::Lambda;
-    /// Lane `i`'s wavelengths as a packet of width 1.
-    fn one_lane<F: Float>(lam: &Self::Lanes<F>, i: usize) -> Self::Lanes<f32>;
     /// Throughput of a new path: one on every live wavelength.
     fn initial_beta<F: Float, const N: usize>(lam: &Self::Lanes<F>) -> Chan<F, N>;
     /// The IOR of a dielectric at lane `i`'s hero wavelength, and whether it disperses (so
@@ -300,7 +298,7 @@ pub trait Transport: Copy + Send + Sync + 'static {
         m: F::Mask,
     );
 
-    /// An empty record of lane colours.
+    /// An empty record of lane colours, in which each lane is set at most once.
     fn colours() -> Self::Colours;
     /// Lane `i`: material `mat`'s reflectance, `rgb` its (possibly texture-modulated) colour.
     fn set_reflectance(
@@ -335,8 +333,14 @@ pub trait Transport: Copy + Send + Sync + 'static {
     fn set_environment<F: Float>(c: &mut Self::Colours, i: usize, ctx: &Ctx, lam: &Self::Lanes<F>);
     /// The recorded colours at every lane's wavelengths (lanes never set are unspecified).
     fn eval<F: Float, const N: usize>(c: &Self::Colours, lam: &Self::Lanes<F>) -> Chan<F, N>;
-    /// The paths' radiance as linear sRGB for the film.
-    fn to_rgb<F: Float, const N: usize>(l: &Chan<F, N>, lam: &Self::Lanes<F>) -> V3<F>;
+    /// The radiance `l` of each lane in `ended` (bit i: lane i) as linear sRGB for the film,
+    /// into `rgb[i]`.
+    fn ended_rgb<F: Float, const N: usize>(
+        l: &Chan<F, N>,
+        lam: &Self::Lanes<F>,
+        ended: u32,
+        rgb: &mut [Vec3; MAX_W],
+    );
 
     /// One path's radiance of light sample `ls`.
     #[inline(always)]
@@ -395,8 +399,6 @@ impl Transport for Rgb {
     #[inline(always)]
     fn lane<F: Float>(_: &(), _: usize) {}
     #[inline(always)]
-    fn one_lane<F: Float>(_: &(), _: usize) {}
-    #[inline(always)]
     fn initial_beta<F: Float, const N: usize>(_: &()) -> Chan<F, N> {
         Chan([F::one(); N])
     }
@@ -449,8 +451,18 @@ impl Transport for Rgb {
         chan([F::load(&c.0[0]), F::load(&c.0[1]), F::load(&c.0[2])])
     }
     #[inline(always)]
-    fn to_rgb<F: Float, const N: usize>(l: &Chan<F, N>, _: &()) -> V3<F> {
-        V3::new(l.0[0], l.0[1], l.0[2])
+    fn ended_rgb<F: Float, const N: usize>(
+        l: &Chan<F, N>,
+        _: &(),
+        ended: u32,
+        rgb: &mut [Vec3; MAX_W],
+    ) {
+        let v = V3::new(l.0[0], l.0[1], l.0[2]);
+        for (i, rgb) in rgb.iter_mut().enumerate().take(F::WIDTH) {
+            if ended >> i & 1 != 0 {
+                *rgb = v.lane(i);
+            }
+        }
     }
     #[inline(always)]
     fn source_radiance(_: &Ctx, _: &LightSource, rgb: Vec3, _: &()) -> Vec3 {
@@ -488,14 +500,14 @@ pub struct SpectralColours {
 }
 
 impl SpectralColours {
+    /// Lane `i` is the reflectance `s`. A record is fresh from [`Transport::colours`] and each
+    /// lane is set at most once, so s₂, k and the flags still hold their neutral values.
     #[inline(always)]
     fn sigmoid(&mut self, i: usize, s: &RgbSigmoid) {
+        debug_assert!((self.d65 | self.phys) >> i & 1 == 0 && self.s2[i] == 1.0);
         let c = s.coeffs();
         (self.c[0][i], self.c[1][i], self.c[2][i]) = (c[0], c[1], c[2]);
-        (self.s1[i], self.s2[i], self.k[i]) = (s.scale(), 1.0, 1.0);
-        let bit = !(1u32 << i);
-        self.d65 &= bit;
-        self.phys &= bit;
+        self.s1[i] = s.scale();
     }
 
     /// Lane `i` emits `spec` (times the reflectance `tint`, a texture's, if any) times `k`.
@@ -567,13 +579,6 @@ impl Transport for Spectral {
     #[inline(always)]
     fn lane<F: Float>(lam: &LaneWavelengths<F>, i: usize) -> Wavelengths {
         lam.lane(i)
-    }
-    #[inline(always)]
-    fn one_lane<F: Float>(lam: &LaneWavelengths<F>, i: usize) -> LaneWavelengths<f32> {
-        LaneWavelengths {
-            lambda: lam.lambda.map(|x| x.lane(i)),
-            pdf: lam.pdf.map(|x| x.lane(i)),
-        }
     }
     #[inline(always)]
     fn initial_beta<F: Float, const N: usize>(lam: &LaneWavelengths<F>) -> Chan<F, N> {
@@ -693,7 +698,7 @@ impl Transport for Spectral {
             let l = lam.lambda[w];
             let mut v = spectrum_lanes::sigmoid(&coeffs, s1, l) * s2;
             if c.d65 != 0 {
-                v = F::select(d65, v * spectrum_lanes::illuminant(l), v);
+                v = F::select(d65, v * lam.illum[w], v);
             }
             if c.phys != 0 {
                 v = F::select(phys, v * F::load(&c.p[w]), v);
@@ -703,12 +708,33 @@ impl Transport for Spectral {
         chan(out)
     }
     #[inline(always)]
-    fn to_rgb<F: Float, const N: usize>(l: &Chan<F, N>, lam: &LaneWavelengths<F>) -> V3<F> {
-        let mut a = [F::zero(); N_LAMBDA];
-        for (a, l) in a.iter_mut().zip(l.0) {
-            *a = l;
+    fn ended_rgb<F: Float, const N: usize>(
+        l: &Chan<F, N>,
+        lam: &LaneWavelengths<F>,
+        ended: u32,
+        rgb: &mut [Vec3; MAX_W],
+    ) {
+        // 24 table lookups per lane: only the lanes that ended pay for them, one at a time by
+        // the one-path functions (plain loads where the packet would gather for every lane).
+        let mut v = [[0.0f32; MAX_W]; 3 * N_LAMBDA];
+        for k in 0..N_LAMBDA {
+            l.0[k].store(&mut v[k]);
+            lam.lambda[k].store(&mut v[N_LAMBDA + k]);
+            lam.pdf[k].store(&mut v[2 * N_LAMBDA + k]);
         }
-        spectrum_lanes::to_linear_srgb(&a, lam)
+        let mut bits = ended;
+        while bits != 0 {
+            let i = bits.trailing_zeros() as usize;
+            bits &= bits - 1;
+            let mut s = SampledSpectrum::ZERO;
+            let mut w = Wavelengths::default();
+            for k in 0..N_LAMBDA {
+                s.0[k] = v[k][i];
+                w.lambda[k] = v[N_LAMBDA + k][i];
+                w.pdf[k] = v[2 * N_LAMBDA + k][i];
+            }
+            rgb[i] = crate::spectrum::xyz_to_linear_srgb(crate::spectrum::to_xyz(&s, &w));
+        }
     }
     #[inline(always)]
     fn source_radiance(
@@ -718,10 +744,7 @@ impl Transport for Spectral {
         lam: &Wavelengths,
     ) -> SampledSpectrum {
         // The lane code at width 1: one description of every emitter's spectrum.
-        let lanes = LaneWavelengths::<f32> {
-            lambda: lam.lambda,
-            pdf: lam.pdf,
-        };
+        let lanes = LaneWavelengths::<f32>::new(lam.lambda, lam.pdf);
         let mut c = Self::colours();
         Self::set_source::<f32>(&mut c, 0, ctx, source, rgb, &lanes);
         SampledSpectrum(Self::eval::<f32, N_LAMBDA>(&c, &lanes).0)

@@ -1,14 +1,13 @@
-//! The per-path spectral functions over lanes: wavelength sampling, the RGB spectra, the
-//! illuminant table, the colour matching functions and the film's XYZ → sRGB step, one lane
-//! per path. Each computes what its scalar counterpart computes, operation for operation (no
+//! The per-path spectral functions over lanes: wavelength sampling, the RGB spectra and the
+//! illuminant table, one lane per path. (The film's XYZ → sRGB step runs per ended path,
+//! through the scalar functions: plain loads beat a packet's gathers there.) Each computes what its scalar counterpart computes, operation for operation (no
 //! fused multiply-add where the scalar code has none), so a path's numbers do not depend on
 //! the width it runs at; `tests` checks them against the scalar functions bit for bit.
 
-use super::cie::{CMF_F32, CMF_ROWS, XYZ_TO_SRGB};
 use super::rgb2spec::{ILLUMINANT_1NM, INV_T_HALF, T_CENTRE};
 use super::sampled::{VIS_A, VIS_MU, VIS_NORM, VIS_T0, VIS_T1};
-use super::{CIE_Y_INTEGRAL, LAMBDA_MAX, LAMBDA_MIN, N_LAMBDA, Wavelengths};
-use crate::simd::{Float, Mask, UInt, V3};
+use super::{LAMBDA_MAX, LAMBDA_MIN, N_LAMBDA, Wavelengths};
+use crate::simd::{Float, Mask, UInt};
 
 /// Each lane's [`Wavelengths`]: `lambda[k]` and `pdf[k]` hold wavelength `k` of every lane.
 #[derive(Clone, Copy, Debug)]
@@ -17,6 +16,10 @@ pub struct LaneWavelengths<F> {
     pub lambda: [F; N_LAMBDA],
     /// Density of each wavelength, 1/nm.
     pub pdf: [F; N_LAMBDA],
+    /// The unit-luminance D65 ([`illuminant`]) at each wavelength. RGB emitters multiply by
+    /// it at every evaluation, and a path's wavelengths never change: looked up once when
+    /// they are drawn, not by two gathers per wavelength at every emitter.
+    pub illum: [F; N_LAMBDA],
 }
 
 impl<F: Float> LaneWavelengths<F> {
@@ -26,7 +29,18 @@ impl<F: Float> LaneWavelengths<F> {
         LaneWavelengths {
             lambda: [F::zero(); N_LAMBDA],
             pdf: [F::zero(); N_LAMBDA],
+            illum: [F::zero(); N_LAMBDA],
         }
+    }
+
+    /// Wavelengths `lambda` with densities `pdf`, and the illuminant at each.
+    #[inline(always)]
+    pub fn new(lambda: [F; N_LAMBDA], pdf: [F; N_LAMBDA]) -> Self {
+        let mut illum = [F::zero(); N_LAMBDA];
+        for (i, &l) in illum.iter_mut().zip(&lambda) {
+            *i = illuminant(l);
+        }
+        LaneWavelengths { lambda, pdf, illum }
     }
 
     /// [`Wavelengths::sample_visible`] in every lane.
@@ -34,24 +48,24 @@ impl<F: Float> LaneWavelengths<F> {
     pub fn sample_visible(u: F) -> Self {
         let u = F::select(u.is_finite(), u.clamp(F::zero(), F::one()), F::zero());
         let (lo, hi) = (F::splat(LAMBDA_MIN), F::splat(LAMBDA_MAX));
-        let mut w = Self::zero();
+        let (mut lambda, mut pdf) = ([F::zero(); N_LAMBDA], [F::zero(); N_LAMBDA]);
         for k in 0..N_LAMBDA {
             let uk = u + F::splat(k as f32 / N_LAMBDA as f32);
             let uk = F::select(uk.ge(F::one()), uk - F::one(), uk);
             let t = F::splat(VIS_T0) + uk * F::splat(VIS_T1 - VIS_T0);
-            w.lambda[k] = (F::splat(VIS_MU) + atanh(t) / F::splat(VIS_A)).clamp(lo, hi);
-            w.pdf[k] = F::splat(VIS_NORM) * (F::one() - t * t);
+            lambda[k] = (F::splat(VIS_MU) + atanh(t) / F::splat(VIS_A)).clamp(lo, hi);
+            pdf[k] = F::splat(VIS_NORM) * (F::one() - t * t);
         }
-        w
+        Self::new(lambda, pdf)
     }
 
     /// Every lane carries the one wavelength `lambda` with pdf 1 (a monochromatic render).
     #[inline(always)]
     pub fn monochromatic(lambda: f32) -> Self {
-        LaneWavelengths {
-            lambda: [F::splat(lambda); N_LAMBDA],
-            pdf: [F::one(), F::zero(), F::zero(), F::zero()],
-        }
+        Self::new(
+            [F::splat(lambda); N_LAMBDA],
+            [F::one(), F::zero(), F::zero(), F::zero()],
+        )
     }
 
     /// `a` in lanes where `m` is set, else `b`.
@@ -61,6 +75,7 @@ impl<F: Float> LaneWavelengths<F> {
         for k in 0..N_LAMBDA {
             w.lambda[k] = F::select(m, a.lambda[k], b.lambda[k]);
             w.pdf[k] = F::select(m, a.pdf[k], b.pdf[k]);
+            w.illum[k] = F::select(m, a.illum[k], b.illum[k]);
         }
         w
     }
@@ -157,44 +172,11 @@ pub fn illuminant<F: Float>(lambda: F) -> F {
     table_1nm(&ILLUMINANT_1NM, ILLUMINANT_1NM.len(), 1, 0, lambda)
 }
 
-/// [`super::cie_xyz`] at wavelength `lambda` of every lane.
-#[inline(always)]
-pub fn cie_xyz<F: Float>(lambda: F) -> V3<F> {
-    let t = CMF_F32.as_flattened();
-    V3::new(
-        table_1nm(t, CMF_ROWS, 3, 0, lambda),
-        table_1nm(t, CMF_ROWS, 3, 1, lambda),
-        table_1nm(t, CMF_ROWS, 3, 2, lambda),
-    )
-}
-
-/// [`super::to_xyz`] then [`super::xyz_to_linear_srgb`] in every lane: the film's colour of
-/// radiance `l` carried at wavelengths `w`.
-#[inline(always)]
-pub fn to_linear_srgb<F: Float>(l: &[F; N_LAMBDA], w: &LaneWavelengths<F>) -> V3<F> {
-    let mut xyz = V3::<F>::zero();
-    for (k, &lk) in l.iter().enumerate() {
-        let live = w.pdf[k].ne(F::zero());
-        let term = cie_xyz(w.lambda[k]) * (lk / w.pdf[k]);
-        xyz = V3::select(live, xyz + term, xyz);
-    }
-    let n = F::splat(N_LAMBDA as f32 * CIE_Y_INTEGRAL);
-    let xyz = V3::new(xyz.x / n, xyz.y / n, xyz.z / n);
-    // glam's Mat3 × Vec3: column by column, unfused.
-    let col = |c: glam::Vec3| V3::new(F::splat(c.x), F::splat(c.y), F::splat(c.z));
-    let (c0, c1, c2) = (
-        col(XYZ_TO_SRGB.x_axis),
-        col(XYZ_TO_SRGB.y_axis),
-        col(XYZ_TO_SRGB.z_axis),
-    );
-    c0 * xyz.x + c1 * xyz.y + c2 * xyz.z
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
     use crate::simd::PortableF32;
-    use crate::spectrum::{RgbIlluminant, RgbSigmoid, SampledSpectrum, to_xyz, xyz_to_linear_srgb};
+    use crate::spectrum::{RgbIlluminant, RgbSigmoid};
     use glam::Vec3;
 
     type P8 = PortableF32<8>;
@@ -238,6 +220,11 @@ mod tests {
                 assert_eq!(bits(&lanes.lane(i)), bits(&want), "u = {}", u.lane(i));
                 let one = LaneWavelengths::<f32>::sample_visible(u.lane(i)).lane(0);
                 assert_eq!(bits(&one), bits(&want));
+                // The stored illuminant is the path's D65, as an emitter would look it up.
+                let d65 = RgbIlluminant::illuminant4(want.lambda);
+                for (k, d) in d65.iter().enumerate() {
+                    assert_eq!(lanes.illum[k].lane(i).to_bits(), d.to_bits());
+                }
             }
         }
     }
@@ -279,22 +266,15 @@ mod tests {
     }
 
     #[test]
-    fn tables_match_the_scalar_lookups_bit_for_bit() {
+    fn the_illuminant_table_matches_the_scalar_lookup_bit_for_bit() {
         let ls = lambdas();
         for chunk in ls.chunks(8) {
             let l = P8::from_fn(|i| chunk[i % chunk.len()]);
             let ill = illuminant(l);
-            let cmf = cie_xyz(l);
             for i in 0..8 {
                 let x = l.lane(i);
                 let want = RgbIlluminant::illuminant4([x; 4])[0];
                 assert_eq!(ill.lane(i).to_bits(), want.to_bits(), "illuminant at {x}");
-                let want = crate::spectrum::cie_xyz(x);
-                let got = Vec3::new(cmf.x.lane(i), cmf.y.lane(i), cmf.z.lane(i));
-                assert_eq!(
-                    got.to_array().map(f32::to_bits),
-                    want.to_array().map(f32::to_bits)
-                );
             }
         }
     }
@@ -320,36 +300,6 @@ mod tests {
                     let got = sigmoid(&c, P8::splat(s.scale()), P8::splat(x)).lane(3);
                     assert_eq!(got.to_bits(), want[k].to_bits(), "{rgb} at {x}");
                 }
-            }
-        }
-    }
-
-    #[test]
-    #[allow(clippy::needless_range_loop)]
-    fn film_colour_matches_to_xyz_then_srgb_bit_for_bit() {
-        let mut rng = 0x1234_5678u32;
-        let mut next = || {
-            rng ^= rng << 13;
-            rng ^= rng >> 17;
-            rng ^= rng << 5;
-            rng as f32 / u32::MAX as f32
-        };
-        for _ in 0..2_000 {
-            let us: [f32; 8] = std::array::from_fn(|_| next());
-            let mut w = LaneWavelengths::sample_visible(P8::from_fn(|i| us[i]));
-            let half = crate::simd::PortableMask::<8>::from_fn(|i| i >= 4);
-            w.terminate_secondary(half);
-            let l: [[f32; 8]; 4] = std::array::from_fn(|_| std::array::from_fn(|_| next() * 3.0));
-            let lanes = l.map(|c| P8::from_fn(|i| c[i]));
-            let rgb = to_linear_srgb(&lanes, &w);
-            for i in 0..8 {
-                let s = SampledSpectrum(std::array::from_fn(|k| l[k][i]));
-                let want = xyz_to_linear_srgb(to_xyz(&s, &w.lane(i)));
-                let got = Vec3::new(rgb.x.lane(i), rgb.y.lane(i), rgb.z.lane(i));
-                assert_eq!(
-                    got.to_array().map(f32::to_bits),
-                    want.to_array().map(f32::to_bits)
-                );
             }
         }
     }
