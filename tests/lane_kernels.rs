@@ -538,3 +538,168 @@ fn lane_ray_offsets_are_the_scalar_offsets() {
         }
     }
 }
+
+struct LightKernel<'a> {
+    scene: &'a RenderScene,
+    /// Reference point, light choice, (ux, uy).
+    queries: &'a [(Vec3, f32, f32, f32)],
+}
+
+/// A light sample's direction, radiance, density, delta flag, and point with its normal.
+type LightFields = (Vec3, Vec3, f32, bool, Option<(Vec3, Vec3)>);
+
+/// A light sample as comparable numbers: `[0]` without a sample, else its fields and its
+/// source (as printed).
+fn light_record(s: Option<LightFields>, source: String) -> Vec<u32> {
+    let Some((wi, radiance, pdf, delta, point)) = s else {
+        return vec![0];
+    };
+    let (q, nq) = point.unwrap_or((Vec3::NAN, Vec3::NAN));
+    let mut v = vec![1, u32::from(delta), u32::from(point.is_some())];
+    v.extend(
+        [wi, radiance, q, nq]
+            .iter()
+            .flat_map(|x| x.to_array())
+            .chain([pdf])
+            .map(f32::to_bits),
+    );
+    v.extend(source.bytes().map(u32::from));
+    v
+}
+
+impl LaneKernel for LightKernel<'_> {
+    type Output = Vec<Vec<u32>>;
+    #[inline(always)]
+    fn run<F: Float>(self) -> Vec<Vec<u32>> {
+        let (q, lights, prims) = (self.queries, &self.scene.lights, &self.scene.prims);
+        chunks::<F, u32>(q.len(), |idx| {
+            let p = V3::<F>::from_fn(|l| q[idx(l)].0);
+            let sel = F::from_fn(|l| q[idx(l)].1);
+            let (ux, uy) = (F::from_fn(|l| q[idx(l)].2), F::from_fn(|l| q[idx(l)].3));
+            let mut sources = [prism::scene::lights::LightSource::Environment; 16];
+            let all = <F::Mask as simd::Mask>::splat(true);
+            let s = lights.sample_lanes::<F, false>(
+                prims,
+                p,
+                all,
+                sel,
+                ux,
+                uy,
+                F::zero(),
+                true,
+                Some(&mut sources),
+            );
+            (0..F::WIDTH)
+                .map(|l| {
+                    let has = simd::Mask::lane(s.has, l);
+                    let point =
+                        simd::Mask::lane(s.at_point, l).then(|| (s.q.lane(l), s.nq.lane(l)));
+                    let rec = has.then(|| {
+                        let delta = simd::Mask::lane(s.delta, l);
+                        (
+                            s.wi.lane(l),
+                            s.radiance.lane(l),
+                            s.pdf.lane(l),
+                            delta,
+                            point,
+                        )
+                    });
+                    light_record(
+                        rec,
+                        if has {
+                            format!("{:?}", sources[l])
+                        } else {
+                            String::new()
+                        },
+                    )
+                })
+                .collect()
+        })
+    }
+}
+
+/// Every kind of light sampled over lanes (the environment, point and spot lights, Rect, Disk
+/// and Sphere emitters, and a textured one, which takes the one-lane path) gives, lane for
+/// lane, the scalar sample's bits and source; reference points include ones inside the
+/// sphere light, behind the one-sided lamps and on the spot's edge.
+#[test]
+fn lane_light_samples_are_the_scalar_light_samples() {
+    let dir = std::env::temp_dir().join(format!("prism-lane-lights-{}", std::process::id()));
+    std::fs::create_dir_all(&dir).unwrap();
+    let path = dir.join("lights.ron");
+    std::fs::write(
+        &path,
+        r#"#![enable(implicit_some)]
+Scene(
+    render: (width: 8, height: 8, spp: 1),
+    camera: (position: (0.0, 1.0, 6.0), look_at: (0.0, 1.0, 0.0), fov_y: 40.0),
+    environment: Constant(Rgb(0.1, 0.2, 0.3)),
+    entities: [
+        (name: "rect", shape: Rect(center: (0.0, 3.0, 0.0), u: (0.5, 0.0, 0.0), v: (0.0, 0.0, 0.5)),
+         material: Light(emission: Rgb(4.0, 3.0, 2.0))),
+        (name: "disk", shape: Disk(center: (2.0, 2.0, 0.0), normal: (-1.0, -1.0, 0.0), radius: 0.4),
+         material: Light(emission: Rgb(2.0, 2.0, 5.0), two_sided: true)),
+        (name: "ball", shape: Sphere(center: (-2.0, 1.0, 0.0), radius: 0.5),
+         material: Light(emission: Rgb(6.0, 1.0, 1.0))),
+        (name: "tex", shape: Rect(center: (0.0, 1.0, -3.0), u: (1.0, 0.0, 0.0), v: (0.0, 1.0, 0.0)),
+         material: Light(emission: Rgb(1.0, 1.0, 1.0)),
+         texture: (albedo: Checker(a: Rgb(0.9, 0.9, 0.9), b: Rgb(0.1, 0.2, 0.6), size: 0.25))),
+        (name: "bulb", light: Point(position: (1.0, 2.5, 1.0), intensity: Rgb(5.0, 4.0, 3.0))),
+        (name: "spot", light: Spot(position: (-1.0, 3.0, 1.0), direction: (0.3, -1.0, 0.0),
+         cone: 30.0, falloff: 10.0, intensity: Rgb(20.0, 20.0, 20.0))),
+        (name: "floor", shape: Rect(center: (0.0, 0.0, 0.0), u: (5.0, 0.0, 0.0), v: (0.0, 0.0, -5.0)),
+         material: Diffuse(albedo: Rgb(0.5, 0.5, 0.5))),
+    ],
+)"#,
+    )
+    .unwrap();
+    let scene = scene_file(&path, &[]);
+    std::fs::remove_dir_all(&dir).ok();
+    let mut rng = SplitMix(0x11_6475);
+    let mut u = move || (rng.unit() as f32).min(0.999_999_94);
+    let mut queries = Vec::new();
+    for k in 0..20_000 {
+        let p = match k % 4 {
+            // Inside the sphere light, near its surface, and anywhere in the room.
+            0 => Vec3::new(-2.0, 1.0, 0.0) + (Vec3::new(u(), u(), u()) - 0.5) * 0.9,
+            1 => Vec3::new(-2.0, 1.0, 0.0) + (Vec3::new(u(), u(), u()) - 0.5) * 1.2,
+            _ => Vec3::new(u() * 8.0 - 4.0, u() * 5.0 - 0.5, u() * 8.0 - 4.0),
+        };
+        queries.push((p, u(), u(), u()));
+    }
+    let want: Vec<Vec<u32>> = queries
+        .iter()
+        .map(|&(p, sel, ux, uy)| {
+            let s =
+                scene
+                    .lights
+                    .sample::<false>(&scene.prims, p, sel, Vec2::new(ux, uy), 0.0, true);
+            let source = s.map(|s| format!("{:?}", s.source)).unwrap_or_default();
+            light_record(
+                s.map(|s| (s.wi, s.radiance, s.pdf, s.delta, s.point)),
+                source,
+            )
+        })
+        .collect();
+    // Every kind of light gave samples.
+    let printed: Vec<String> = want
+        .iter()
+        .map(|v| v.iter().skip(16).map(|&b| b as u8 as char).collect())
+        .collect();
+    for kind in ["Environment", "Point", "Area"] {
+        let n = printed.iter().filter(|s| s.starts_with(kind)).count();
+        assert!(n > 1000, "{kind}: {n} samples");
+    }
+    for lanes in forms() {
+        let got = simd::dispatch(
+            lanes,
+            LightKernel {
+                scene: &scene,
+                queries: &queries,
+            },
+        );
+        for (k, (g, w)) in got.iter().zip(&want).enumerate() {
+            assert_eq!(g, w, "{} at {:?}", lanes.describe(), queries[k]);
+        }
+    }
+}

@@ -45,18 +45,23 @@ impl PointLight {
     /// The spot's angular factor in [0, 1] towards unit direction `w` (1 for a point light).
     #[inline]
     pub fn falloff(&self, w: Vec3) -> f32 {
+        self.falloff_lanes::<f32>(crate::simd::V3::splat(w))
+    }
+
+    /// [`PointLight::falloff`] towards one unit direction per lane.
+    #[inline(always)]
+    pub fn falloff_lanes<F: crate::simd::Float>(&self, w: crate::simd::V3<F>) -> F {
         if self.cos_cone <= -1.0 {
-            return 1.0;
+            return F::one();
         }
-        let c = w.dot(self.direction);
-        if c >= self.cos_falloff_start {
-            1.0
-        } else if c <= self.cos_cone {
-            0.0
-        } else {
-            let x = (c - self.cos_cone) / (self.cos_falloff_start - self.cos_cone);
-            x * x * (3.0 - 2.0 * x)
-        }
+        let d = self.direction;
+        // glam's unfused dot product.
+        let c = w.x * F::splat(d.x) + w.y * F::splat(d.y) + w.z * F::splat(d.z);
+        let (cone, start) = (F::splat(self.cos_cone), F::splat(self.cos_falloff_start));
+        let x = (c - cone) / (start - cone);
+        let smooth = x * x * (F::splat(3.0) - F::splat(2.0) * x);
+        let edge = F::select(c.le(cone), F::zero(), smooth);
+        F::select(c.ge(start), F::one(), edge)
     }
 
     /// Emitted power (scene units), for choosing lights by power.

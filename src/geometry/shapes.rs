@@ -189,36 +189,59 @@ impl Sphere {
     }
 
     /// Samples the cone of directions the sphere subtends from `ref_p` (uniform in solid
-    /// angle); from inside, uniformly by area.
+    /// angle); from inside, uniformly by area. [`Sphere::sample_lanes`] at width 1.
     pub fn sample(&self, ref_p: Vec3, u: Vec2) -> Option<ShapeSample> {
-        let dc2 = (ref_p - self.center).length_squared();
-        let r2 = self.radius * self.radius;
-        if dc2 <= r2 * 1.0001 {
-            let n = crate::sampling::square_to_uniform_sphere(u);
-            let p = self.center + n * self.radius;
-            let pdf = solid_angle_pdf(1.0 / self.area(), ref_p, p, n);
-            return (pdf > 0.0 && pdf.is_finite()).then_some(ShapeSample { p, n, pdf });
-        }
+        let (p, n, pdf, ok) = self.sample_lanes::<f32>(V3::splat(ref_p), u.x, u.y);
+        ok.then_some(ShapeSample {
+            p: p.into(),
+            n: n.into(),
+            pdf,
+        })
+    }
+
+    /// [`Sphere::sample`] from one reference point per lane: the point, its normal, its
+    /// solid-angle density, and the lanes that hold a sample. Both cases are computed in
+    /// every lane and selected.
+    #[inline(always)]
+    pub fn sample_lanes<F: Float>(&self, ref_p: V3<F>, ux: F, uy: F) -> (V3<F>, V3<F>, F, F::Mask) {
+        use crate::sampling::warp::lanes as warp;
+        let (zero, one) = (F::zero(), F::one());
+        let c = V3::splat(self.center);
+        let radius = F::splat(self.radius);
+        let rel = ref_p - c;
+        let dc2 = dot(rel, rel);
+        let r2 = F::splat(self.radius * self.radius);
+        let inside = dc2.le(r2 * F::splat(1.0001));
+        // Inside (or on) the sphere: uniform by area.
+        let n_in = warp::square_to_uniform_sphere(ux, uy);
+        let p_in = c + n_in * radius;
+        let pdf_in = solid_angle_pdf_lanes(F::splat(1.0 / self.area()), ref_p, p_in, n_in);
+        let ok_in = pdf_in.gt(zero) & pdf_in.is_finite();
+        // Outside: uniform in the cone it subtends.
         let dc = dc2.sqrt();
         let sin2_max = r2 / dc2;
-        let cos_max = (1.0 - sin2_max).max(0.0).sqrt();
-        let w = (self.center - ref_p) / dc;
-        let local = crate::sampling::square_to_uniform_cone(u, cos_max);
-        let (t, b) = crate::sampling::coordinate_system(w);
+        let cos_max = max_num(one - sin2_max, zero).sqrt();
+        let toward = c - ref_p;
+        let w = V3::new(toward.x / dc, toward.y / dc, toward.z / dc);
+        let local = warp::square_to_uniform_cone_one_minus_cos(ux, uy, one - cos_max);
+        let (t, b) = warp::coordinate_system(w);
         let dir = t * local.x + b * local.y + w * local.z;
         // The point on the sphere along `dir`: the near root of the ray–sphere quadratic,
         // clamped to the tangent point when rounding puts the direction just outside.
-        let bq = (ref_p - self.center).dot(dir);
-        let disc = (bq * bq - (dc2 - r2)).max(0.0);
+        let bq = dot(rel, dir);
+        let disc = max_num(bq * bq - (dc2 - r2), zero);
         let tq = -bq - disc.sqrt();
         let p_raw = ref_p + dir * tq;
-        let n = (p_raw - self.center).normalize_or(-w);
-        let pdf = crate::sampling::uniform_cone_pdf(cos_max);
-        Some(ShapeSample {
-            p: self.center + n * self.radius,
-            n,
-            pdf,
-        })
+        // glam's `normalize_or(-w)`.
+        let v = p_raw - c;
+        let rcp = one / dot(v, v).sqrt();
+        let unit = rcp.is_finite() & rcp.gt(zero);
+        let n_out = V3::select(unit, v * rcp, -w);
+        let pdf_out = one / (F::splat(std::f32::consts::TAU) * (one - cos_max));
+        let n = V3::select(inside, n_in, n_out);
+        let p = V3::select(inside, p_in, c + n_out * radius);
+        let pdf = F::select(inside, pdf_in, pdf_out);
+        (p, n, pdf, ok_in | !inside)
     }
 
     /// Solid-angle density of `sample` for a direction from `ref_p` that hits at `p`.
@@ -357,17 +380,14 @@ impl Planar {
 
     /// Uniform by area. (Solid-angle sampling of spherical rectangles only applies to true
     /// rectangles; affine transforms make general parallelograms and ellipses, so area
-    /// sampling serves every planar emitter.)
+    /// sampling serves every planar emitter.) [`Planar::sample_lanes`] at width 1.
     pub fn sample(&self, ref_p: Vec3, u: Vec2, disk: bool) -> Option<ShapeSample> {
-        let (a, b) = if disk {
-            let d = crate::sampling::square_to_uniform_disk_concentric(u);
-            (d.x, d.y)
-        } else {
-            (2.0 * u.x - 1.0, 2.0 * u.y - 1.0)
-        };
-        let p = self.center + a * self.u + b * self.v;
-        let pdf = solid_angle_pdf(1.0 / self.area, ref_p, p, self.n);
-        (pdf > 0.0 && pdf.is_finite()).then_some(ShapeSample { p, n: self.n, pdf })
+        let (p, pdf) = self.sample_lanes::<f32>(V3::splat(ref_p), u.x, u.y, disk);
+        (pdf > 0.0).then_some(ShapeSample {
+            p: p.into(),
+            n: self.n,
+            pdf,
+        })
     }
 
     /// Solid-angle density of [`Planar::sample`] at `p` seen from `ref_p`.
@@ -375,12 +395,16 @@ impl Planar {
         solid_angle_pdf(1.0 / self.area, ref_p, p, self.n)
     }
 
-    /// [`Planar::sample`] of a rectangle from one reference point per lane, with the same
-    /// bits: the point and its solid-angle density, 0 where the scalar sample is `None`.
+    /// [`Planar::sample`] from one reference point per lane: the point and its solid-angle
+    /// density, 0 where there is no sample.
     #[inline(always)]
-    pub fn sample_rect_lanes<F: Float>(&self, ref_p: V3<F>, ux: F, uy: F) -> (V3<F>, F) {
-        let (one, two) = (F::one(), F::splat(2.0));
-        let (a, b) = (two * ux - one, two * uy - one);
+    pub fn sample_lanes<F: Float>(&self, ref_p: V3<F>, ux: F, uy: F, disk: bool) -> (V3<F>, F) {
+        let (a, b) = if disk {
+            crate::sampling::warp::lanes::square_to_uniform_disk_concentric(ux, uy)
+        } else {
+            let (one, two) = (F::one(), F::splat(2.0));
+            (two * ux - one, two * uy - one)
+        };
         let p = V3::splat(self.center) + V3::splat(self.u) * a + V3::splat(self.v) * b;
         let pdf = solid_angle_pdf_lanes(F::splat(1.0 / self.area), ref_p, p, V3::splat(self.n));
         let ok = pdf.gt(F::zero()) & pdf.is_finite();

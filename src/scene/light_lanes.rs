@@ -1,9 +1,9 @@
 //! Light samples from a packet of reference points, one per lane.
 //!
 //! The light is chosen per lane by the alias table; lanes that chose the same light are then
-//! sampled together. Rectangular emitters (the common case: every shipped scene but two lights
-//! its room with one) are sampled in lanes, with the scalar sample's bits. Other lights, and
-//! rectangles that move or carry a texture, take [`Lights::sample`] one lane at a time.
+//! sampled together, in lanes, with the scalar sample's bits: the environment, point and spot
+//! lights, and Rect, Disk and Sphere emitters. Emitters that move or carry a texture take
+//! [`Lights::sample`] one lane at a time.
 
 use super::lights::{LightKind, LightSource, Lights};
 use super::primitives::{NO_MOTION, PrimKind, Primitives};
@@ -114,19 +114,32 @@ impl Lights {
             }
             todo &= !group;
             let gm = M::<F>::from_fn(|i| group >> i & 1 != 0);
-            if let Some(s) = self.rect_lanes::<F, MOTION>(prims, k, p, gm, pmf, ux, uy, textures) {
+            if let Some((s, scale)) =
+                self.light_lanes::<F, MOTION>(prims, k, p, gm, pmf, ux, uy, textures)
+            {
                 out.blend(gm, &s);
-                if let Some(sources) = sources.as_deref_mut()
-                    && let LightKind::Area(prim) = self.lights[k as usize]
-                {
-                    let source = LightSource::Area {
-                        material: prims.material[prim as usize],
-                        tex: None,
-                        prim,
+                if let Some(sources) = sources.as_deref_mut() {
+                    let source = match self.lights[k as usize] {
+                        LightKind::Area(prim) => LightSource::Area {
+                            material: prims.material[prim as usize],
+                            tex: None,
+                            prim,
+                        },
+                        LightKind::Point(_) => LightSource::Point {
+                            light: k,
+                            scale: 0.0,
+                        },
+                        LightKind::Environment(_) => LightSource::Environment,
                     };
                     for (i, s) in sources.iter_mut().enumerate().take(F::WIDTH) {
                         if group >> i & 1 != 0 {
-                            *s = source;
+                            *s = match source {
+                                LightSource::Point { light, .. } => LightSource::Point {
+                                    light,
+                                    scale: scale.lane(i),
+                                },
+                                s => s,
+                            };
                         }
                     }
                 }
@@ -170,10 +183,13 @@ impl Lights {
         out
     }
 
-    /// Light `k` sampled in lanes `m`, if it is a still, untextured rectangle.
+    /// Light `k` sampled in lanes `m`, with the scalar sample's bits: the environment, a
+    /// point or spot light (with each lane's falloff / d², its source's scale), or a still,
+    /// untextured Rect, Disk or Sphere. `None` for the rest (moving or textured emitters),
+    /// which the caller samples one lane at a time.
     #[inline(always)]
     #[allow(clippy::too_many_arguments)]
-    fn rect_lanes<F: Float, const MOTION: bool>(
+    fn light_lanes<F: Float, const MOTION: bool>(
         &self,
         prims: &Primitives,
         k: u32,
@@ -183,13 +199,49 @@ impl Lights {
         ux: F,
         uy: F,
         textures: bool,
-    ) -> Option<LaneLightSample<F>> {
-        let LightKind::Area(prim) = self.lights[k as usize] else {
-            return None;
+    ) -> Option<(LaneLightSample<F>, F)> {
+        let no = M::<F>::splat(false);
+        let prim = match self.lights[k as usize] {
+            LightKind::Environment(l) => {
+                let wi = crate::sampling::warp::lanes::square_to_uniform_sphere(ux, uy);
+                let s = LaneLightSample {
+                    has: m,
+                    wi,
+                    radiance: V3::splat(l),
+                    pdf: pmf * F::splat(crate::sampling::uniform_sphere_pdf()),
+                    delta: no,
+                    at_point: no,
+                    q: V3::zero(),
+                    nq: V3::zero(),
+                };
+                return Some((s, F::zero()));
+            }
+            LightKind::Point(pl) => {
+                let q = V3::<F>::splat(pl.position);
+                let d = q - p;
+                let d2 = d.x * d.x + d.y * d.y + d.z * d.z;
+                let r = d2.sqrt();
+                let wi = V3::new(d.x / r, d.y / r, d.z / r);
+                let scale = pl.falloff_lanes(-wi) / d2;
+                let radiance = V3::<F>::splat(pl.intensity) * scale;
+                let finite =
+                    radiance.x.is_finite() & radiance.y.is_finite() & radiance.z.is_finite();
+                let s = LaneLightSample {
+                    has: m & nonzero(radiance) & finite,
+                    wi,
+                    radiance,
+                    pdf: pmf,
+                    delta: M::<F>::splat(true),
+                    at_point: M::<F>::splat(true),
+                    q,
+                    nq: V3::zero(),
+                };
+                return Some((s, scale));
+            }
+            LightKind::Area(prim) => prim,
         };
         let i = prim as usize;
-        if prims.kind[i] != PrimKind::Rect
-            || (MOTION && prims.motion[i] != NO_MOTION)
+        if (MOTION && prims.motion[i] != NO_MOTION)
             || (textures && prims.texture_of(prim).is_some())
         {
             return None;
@@ -202,30 +254,38 @@ impl Lights {
         else {
             return None;
         };
-        let rect = &prims.planars[prims.local[i] as usize];
-        let (q, pdf) = rect.sample_rect_lanes(p, ux, uy);
+        let l = prims.local[i] as usize;
+        let (q, nq, pdf, ok) = match prims.kind[i] {
+            PrimKind::Rect | PrimKind::Disk => {
+                let planar = &prims.planars[l];
+                let (q, pdf) = planar.sample_lanes(p, ux, uy, prims.kind[i] == PrimKind::Disk);
+                (q, V3::splat(planar.n), pdf, pdf.gt(F::zero()))
+            }
+            PrimKind::Sphere => prims.spheres[l].sample_lanes(p, ux, uy),
+            PrimKind::Box | PrimKind::Revolution | PrimKind::Mesh => return None,
+        };
         let d = q - p;
         // glam's `normalize_or_zero`.
         let rcp = (d.x * d.x + d.y * d.y + d.z * d.z).sqrt().recip();
         let unit = rcp.is_finite() & rcp.gt(F::zero());
         let wi = V3::select(unit, d * rcp, V3::zero());
-        let n = V3::<F>::splat(rect.n);
         let facing = if two_sided {
             M::<F>::splat(true)
         } else {
             let wo = -wi;
-            (n.x * wo.x + n.y * wo.y + n.z * wo.z).gt(F::zero())
+            (nq.x * wo.x + nq.y * wo.y + nq.z * wo.z).gt(F::zero())
         };
         let lit = M::<F>::splat(emission != glam::Vec3::ZERO) & facing;
-        Some(LaneLightSample {
-            has: m & pdf.gt(F::zero()) & nonzero(wi) & lit,
+        let s = LaneLightSample {
+            has: m & ok & nonzero(wi) & lit,
             wi,
             radiance: V3::splat(emission),
             pdf: pmf * pdf,
-            delta: M::<F>::splat(false),
+            delta: no,
             at_point: M::<F>::splat(true),
             q,
-            nq: n,
-        })
+            nq,
+        };
+        Some((s, F::zero()))
     }
 }
