@@ -207,6 +207,46 @@ fn missing_scene_file_names_the_path() {
     assert!(err.contains("/nonexistent/scene.ron"), "{err}");
 }
 
+/// Hostile paths: a FIFO (which would block a reader forever), a device (`/dev/zero` never
+/// ends) and a directory are refused by name, at once, as a scene and as a mesh.
+#[cfg(unix)]
+#[test]
+fn non_regular_files_are_refused_without_reading_them() {
+    let d = tempfile::tempdir().unwrap();
+    let fifo = d.path().join("pipe.ron");
+    let made = std::process::Command::new("mkfifo").arg(&fifo).status();
+    assert!(made.is_ok_and(|s| s.success()), "mkfifo");
+    let dir = d.path().join("folder.ron");
+    std::fs::create_dir(&dir).unwrap();
+    let started = std::time::Instant::now();
+    for (path, why) in [
+        (fifo.to_str().unwrap(), "not a regular file"),
+        ("/dev/zero", "not a regular file"),
+        (dir.to_str().unwrap(), "a directory"),
+    ] {
+        let err = fails(&["render", path]);
+        assert!(err.contains(path) && err.contains(why), "{err}");
+    }
+    let obj = d.path().join("pipe.obj");
+    let made = std::process::Command::new("mkfifo").arg(&obj).status();
+    assert!(made.is_ok_and(|s| s.success()), "mkfifo");
+    let mesh = write(
+        d.path(),
+        "mesh.ron",
+        &GOOD.replace(
+            "shape: Sphere(center: (0.0, 0.0, 0.0), radius: 1.0)",
+            "shape: Mesh(path: \"pipe.obj\")",
+        ),
+    );
+    let err = fails(&["render", mesh.to_str().unwrap()]);
+    assert!(
+        err.contains("pipe.obj") && err.contains("not a regular file"),
+        "{err}"
+    );
+    // Nothing waited on the FIFO.
+    assert!(started.elapsed().as_secs() < 60);
+}
+
 #[test]
 fn bad_values_are_refused_with_their_valid_range() {
     let d = tempfile::tempdir().unwrap();

@@ -1136,6 +1136,26 @@ fn ply_errors_name_file_and_line() {
         matches!(e, MeshError::Malformed { line: Some(4), .. }),
         "{e}"
     );
+    // A header claiming more than the file holds is refused at its line, before anything is
+    // allocated: the largest count, and 10^11 binary vertices in a few bytes.
+    for (name, count, format) in [
+        ("huge.ply", "18446744073709551615", "ascii"),
+        ("big.ply", "100000000000", "binary_little_endian"),
+    ] {
+        let e = err_of(
+            dir.path(),
+            name,
+            format!(
+                "ply\nformat {format} 1.0\nelement vertex {count}\nproperty float x\n\
+                 property float y\nproperty float z\nend_header\n0 0 0\n"
+            ),
+        );
+        assert!(
+            matches!(e, MeshError::Malformed { line: Some(3), .. }),
+            "{e}"
+        );
+        assert!(e.to_string().contains(&format!("claims {count}")), "{e}");
+    }
     let e = err_of(dir.path(), "magic.ply", "solid\n");
     assert!(
         matches!(e, MeshError::Malformed { line: Some(1), .. }),

@@ -76,7 +76,7 @@ impl Format {
 }
 
 fn read_file(path: &Path) -> Result<Vec<u8>, MeshError> {
-    std::fs::read(path).map_err(|source| MeshError::Io {
+    crate::files::read_bounded(path, crate::files::MAX_MESH_BYTES).map_err(|source| MeshError::Io {
         path: path.to_path_buf(),
         source,
     })
@@ -417,6 +417,23 @@ struct Element {
     name: String,
     count: usize,
     props: Vec<(String, Property)>,
+    /// The header line that declares it.
+    line: usize,
+}
+
+impl Element {
+    /// The fewest body bytes one instance can take: each ASCII value is at least a digit and
+    /// a separator, each binary one its size (a list at least its count).
+    fn min_bytes(&self, encoding: Encoding) -> usize {
+        self.props
+            .iter()
+            .map(|(_, p)| match (encoding, p) {
+                (Encoding::Ascii, _) => 2,
+                (_, Property::Scalar(s)) => s.size(),
+                (_, Property::List { count, .. }) => count.size(),
+            })
+            .sum()
+    }
 }
 
 struct Header {
@@ -645,6 +662,7 @@ fn parse_ply_header(path: &Path, bytes: &[u8]) -> Result<Header, MeshError> {
                     name: name.to_string(),
                     count,
                     props: Vec::new(),
+                    line,
                 });
             }
             Some("property") => {
@@ -680,6 +698,27 @@ fn parse_ply_header(path: &Path, bytes: &[u8]) -> Result<Header, MeshError> {
         }
     }
     let encoding = encoding.ok_or_else(|| malformed(path, None, "header has no `format` line"))?;
+    // The header's counts are the file's claim, not its content: an element claiming more
+    // instances than the bytes after the header can hold is refused before anything is
+    // allocated for it (`element vertex 18446744073709551615` would overflow a reservation).
+    let body = bytes.len() - at;
+    let mut left = body;
+    for el in &elements {
+        match el.count.checked_mul(el.min_bytes(encoding).max(1)) {
+            Some(n) if n <= left => left -= n,
+            _ => {
+                return Err(malformed(
+                    path,
+                    Some(el.line),
+                    format!(
+                        "element `{}` claims {} instances, more than the {body} bytes after \
+                         the header can hold",
+                        el.name, el.count
+                    ),
+                ));
+            }
+        }
+    }
     Ok(Header {
         encoding,
         elements,

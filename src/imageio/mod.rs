@@ -16,7 +16,6 @@ mod srgb;
 #[cfg(test)]
 mod tests;
 
-use std::fs;
 use std::path::Path;
 
 pub use atomic::write_atomic;
@@ -24,6 +23,31 @@ pub use error::FilmError;
 pub(crate) use error::io_reason;
 pub use raster::{ColorSpace, PngOptions, decode_raster};
 pub use srgb::{srgb_decode, srgb_encode};
+
+/// The most pixels an image read from a file may have in all (2²⁸, e.g. 16384 × 16384 or
+/// 32768 × 8192: 3 GiB as the f32 RGB it becomes) and per side. Checked against the file's
+/// header before any pixel is decoded, so a small file claiming a huge image is refused with a
+/// message rather than aborting the process.
+pub const MAX_READ_PIXELS: u64 = 1 << 28;
+/// See [`MAX_READ_PIXELS`].
+pub const MAX_READ_SIDE: u64 = 32_768;
+
+/// The error for an image file whose header claims `width` × `height` pixels, if that is more
+/// than [`MAX_READ_SIDE`] per side or [`MAX_READ_PIXELS`] in all.
+pub(crate) fn check_read_size(path: &Path, width: u64, height: u64) -> Result<(), FilmError> {
+    match width.checked_mul(height) {
+        Some(n) if n <= MAX_READ_PIXELS && width <= MAX_READ_SIDE && height <= MAX_READ_SIDE => {
+            Ok(())
+        }
+        _ => Err(FilmError::Decode {
+            path: path.to_path_buf(),
+            message: format!(
+                "its header claims {width}×{height} pixels; an image may have at most \
+                 {MAX_READ_SIDE} per side and {MAX_READ_PIXELS} (16384×16384) in all"
+            ),
+        }),
+    }
+}
 
 /// Linear-light RGB image, row-major, top row first.
 #[derive(Clone, Debug, PartialEq)]
@@ -200,10 +224,13 @@ pub fn write_image(
 /// - HDR (Radiance): already linear, returned as is. Metadata is `None`.
 pub fn read_image(path: &Path) -> Result<(Image, Option<ImageMeta>), FilmError> {
     let format = ReadFormat::from_path(path)?;
-    let bytes = fs::read(path).map_err(|error| FilmError::Read {
-        path: path.to_path_buf(),
-        error,
-    })?;
+    let bytes =
+        crate::files::read_bounded(path, crate::files::MAX_IMAGE_BYTES).map_err(|error| {
+            FilmError::Read {
+                path: path.to_path_buf(),
+                error,
+            }
+        })?;
     match format {
         ReadFormat::Exr => exr::decode_exr(path, bytes),
         ReadFormat::Raster(f) => decode_raster(path, bytes, f, ColorSpace::Srgb).map(|i| (i, None)),

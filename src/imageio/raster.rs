@@ -72,6 +72,14 @@ pub fn decode_raster(
         path: path.to_path_buf(),
         message,
     };
+    // The header first: its size decides what decoding allocates (and a 12-byte-per-pixel
+    // f32 RGB image follows).
+    let (w, h) = image::ImageReader::with_format(Cursor::new(&bytes[..]), format)
+        .with_guessed_format()
+        .map_err(|e| decode_err(e.to_string()))?
+        .into_dimensions()
+        .map_err(|e| decode_err(e.to_string()))?;
+    super::check_read_size(path, u64::from(w), u64::from(h))?;
     let decoded = image::ImageReader::with_format(Cursor::new(bytes), format)
         .with_guessed_format()
         .map_err(|e| decode_err(e.to_string()))?

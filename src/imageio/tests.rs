@@ -3,6 +3,7 @@
 use super::exr::{decode_exr, encode_exr, exr_header_attributes};
 use super::*;
 use ::exr::prelude::{self as ex, WritableImage};
+use std::fs;
 use std::io;
 use std::path::Path;
 
@@ -245,6 +246,81 @@ fn exr_missing_channel_is_clear_error() {
         msg.contains("rg.exr") && msg.contains("'B'") && msg.contains("A, G, R"),
         "{msg}"
     );
+}
+
+/// CRC-32 (IEEE) of a PNG chunk's type and data.
+fn png_crc(bytes: &[u8]) -> u32 {
+    let mut c = !0u32;
+    for &b in bytes {
+        c ^= u32::from(b);
+        for _ in 0..8 {
+            c = if c & 1 != 0 {
+                0xedb8_8320 ^ (c >> 1)
+            } else {
+                c >> 1
+            };
+        }
+    }
+    !c
+}
+
+/// Small files whose headers claim huge images are refused before any pixel is decoded:
+/// an EXR whose data window is 200000 × 200000 (a 1 × 1 file with its window edited) and a
+/// 45-byte PNG claiming 30000 × 30000 (a header and an empty data chunk). Both fit the pixel cap at their real sizes.
+#[test]
+fn files_claiming_huge_images_are_refused_before_decoding() {
+    let dir = tempfile::tempdir().unwrap();
+    let exr = dir.path().join("huge.exr");
+    write_image(
+        &exr,
+        &Image::filled(1, 1, [0.5; 3]),
+        &META,
+        &PngOptions::default(),
+    )
+    .unwrap();
+    let mut bytes = fs::read(&exr).unwrap();
+    let key = b"dataWindow\0box2i\0";
+    let at = bytes
+        .windows(key.len())
+        .position(|w| w == key)
+        .expect("a dataWindow attribute")
+        + key.len()
+        + 4;
+    for k in [2, 3] {
+        bytes[at + 4 * k..at + 4 * k + 4].copy_from_slice(&199_999i32.to_le_bytes());
+    }
+    fs::write(&exr, &bytes).unwrap();
+    let msg = read_image(&exr).unwrap_err().to_string();
+    assert!(
+        msg.contains("huge.exr") && msg.contains("200000×200000"),
+        "{msg}"
+    );
+
+    let png = dir.path().join("huge.png");
+    let mut ihdr = b"IHDR".to_vec();
+    ihdr.extend(30_000u32.to_be_bytes());
+    ihdr.extend(30_000u32.to_be_bytes());
+    ihdr.extend([8, 2, 0, 0, 0]);
+    let mut file = b"\x89PNG\r\n\x1a\n".to_vec();
+    file.extend(13u32.to_be_bytes());
+    file.extend(&ihdr);
+    file.extend(png_crc(&ihdr).to_be_bytes());
+    // An empty IDAT: the decoder reads the header up to the first data chunk.
+    file.extend(0u32.to_be_bytes());
+    file.extend(b"IDAT");
+    file.extend(png_crc(b"IDAT").to_be_bytes());
+    fs::write(&png, &file).unwrap();
+    let msg = read_image(&png).unwrap_err().to_string();
+    assert!(
+        msg.contains("huge.png") && msg.contains("30000×30000"),
+        "{msg}"
+    );
+    // The same header at a size within the cap gets past the check to the decoder.
+    assert!(check_read_size(&png, 16_384, 16_384).is_ok());
+    assert!(check_read_size(&png, 32_768, 8_192).is_ok());
+    assert!(check_read_size(&png, 16_385, 16_384).is_err());
+    assert!(check_read_size(&png, 32_769, 1).is_err());
+    assert!(check_read_size(&png, u64::MAX, 2).is_err());
 }
 
 #[test]

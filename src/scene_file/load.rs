@@ -62,10 +62,13 @@ pub struct LoadedScene {
 
 /// Reads and parses a scene file, with `--set` overrides applied.
 pub fn load(path: &Path, overrides: &[(String, String)]) -> Result<LoadedScene, SceneError> {
-    let text = std::fs::read_to_string(path).map_err(|source| SceneError::Io {
-        path: path.to_path_buf(),
-        source,
-    })?;
+    let text =
+        crate::files::read_text_bounded(path, crate::files::MAX_SCENE_BYTES).map_err(|source| {
+            SceneError::Io {
+                path: path.to_path_buf(),
+                source,
+            }
+        })?;
     load_str(&text, path, overrides)
 }
 

@@ -167,7 +167,8 @@ impl TexImage {
                 });
             }
         };
-        let bytes = std::fs::read(path).map_err(|e| TextureError::from_io(path, e))?;
+        let bytes = crate::files::read_bounded(path, crate::files::MAX_IMAGE_BYTES)
+            .map_err(|e| TextureError::from_io(path, e))?;
         Self::decode_raster(path, bytes, format, space)
     }
 
