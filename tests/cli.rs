@@ -247,6 +247,24 @@ fn non_regular_files_are_refused_without_reading_them() {
     assert!(started.elapsed().as_secs() < 60);
 }
 
+/// Sample and frame numbers are 32-bit: ranges that would wrap (and silently repeat samples
+/// or render nothing) or list billions of frames are refused.
+#[test]
+fn sample_and_frame_ranges_cannot_wrap() {
+    let d = tempfile::tempdir().unwrap();
+    let scene = write(d.path(), "s.ron", GOOD);
+    let s = scene.to_str().unwrap();
+    let err = fails(&["render", s, "--sample-offset", "4294967295", "--spp", "2"]);
+    assert!(
+        err.contains("--sample-offset 4294967295 with 2 samples"),
+        "{err}"
+    );
+    let err = fails(&["render", s, "--frames", "0..=4294967295"]);
+    assert!(err.contains("out of range"), "{err}");
+    let err = fails(&["render", s, "--frames", "0..4294967295"]);
+    assert!(err.contains("at most 1000000"), "{err}");
+}
+
 #[test]
 fn bad_values_are_refused_with_their_valid_range() {
     let d = tempfile::tempdir().unwrap();

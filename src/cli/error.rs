@@ -25,6 +25,17 @@ pub enum CliError {
     /// `--time-limit` is not a positive number of seconds.
     #[error("--time-limit must be a positive number of seconds, got {0}")]
     TimeLimit(f64),
+    /// `--sample-offset` plus the samples per pixel passes the last 32-bit sample index.
+    #[error(
+        "--sample-offset {offset} with {spp} samples per pixel runs past sample index \
+         4294967295 (sample indices are 32-bit)"
+    )]
+    SampleRange {
+        /// The first sample index.
+        offset: u32,
+        /// Samples per pixel.
+        spp: u32,
+    },
     /// `--threads 0`.
     #[error("--threads must be at least 1")]
     NoThreads,

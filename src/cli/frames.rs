@@ -5,8 +5,23 @@ use super::CliError;
 use std::ops::Range;
 use std::path::{Path, PathBuf};
 
-/// Parses Rust-style ranges: `A..B` is A to B − 1, `A..=B` is A to B.
+/// The most frames one series may have (a frame list is built before rendering).
+pub const MAX_FRAMES: u32 = 1_000_000;
+
+/// Parses Rust-style ranges: `A..B` is A to B − 1, `A..=B` is A to B, at most
+/// [`MAX_FRAMES`] frames.
 pub fn parse_range(s: &str) -> Result<Range<u32>, String> {
+    let r = parse_unbounded(s)?;
+    if r.len() > MAX_FRAMES as usize {
+        return Err(format!(
+            "frame range '{s}' has {} frames; a series may have at most {MAX_FRAMES}",
+            r.len()
+        ));
+    }
+    Ok(r)
+}
+
+fn parse_unbounded(s: &str) -> Result<Range<u32>, String> {
     let bad = || format!("expected a frame, or a range like 0..24 or 0..=23, got '{s}'");
     let num = |v: &str| v.trim().parse::<u32>().map_err(|_| bad());
     if !s.contains("..") {
@@ -22,7 +37,10 @@ pub fn parse_range(s: &str) -> Result<Range<u32>, String> {
         if b < a {
             return Err(format!("frame range '{s}' is empty"));
         }
-        return Ok(a..b + 1);
+        let end = b
+            .checked_add(1)
+            .ok_or_else(|| format!("frame {b} is out of range"))?;
+        return Ok(a..end);
     }
     let (a, b) = s.split_once("..").ok_or_else(bad)?;
     let (a, b) = (num(a)?, num(b)?);
@@ -124,6 +142,13 @@ mod tests {
         assert_eq!(parse_range("3").unwrap(), 3..4, "one frame");
         assert!(parse_range(&u32::MAX.to_string()).is_err());
         assert!(parse_range("-1").is_err());
+        // No wrap to an empty range, and no list of four billion frames.
+        let e = parse_range("0..=4294967295").unwrap_err();
+        assert!(e.contains("out of range"), "{e}");
+        let e = parse_range("0..4294967295").unwrap_err();
+        assert!(e.contains("at most 1000000"), "{e}");
+        assert_eq!(parse_range("7..1000007").unwrap().len(), 1_000_000);
+        assert!(parse_range("7..=1000007").is_err());
     }
 
     #[test]

@@ -92,6 +92,12 @@ fn render_to_file(
         a.simd.unwrap_or(rs.settings.simd)
     };
     let lanes = crate::simd::Lanes::resolve(choice)?;
+    if u64::from(a.sample_offset) + u64::from(spp) > 1 << 32 {
+        return Err(CliError::SampleRange {
+            offset: a.sample_offset,
+            spp,
+        });
+    }
     let opts = RenderOptions {
         sample_offset: a.sample_offset,
         spp,
