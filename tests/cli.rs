@@ -263,6 +263,23 @@ fn sample_and_frame_ranges_cannot_wrap() {
     assert!(err.contains("out of range"), "{err}");
     let err = fails(&["render", s, "--frames", "0..4294967295"]);
     assert!(err.contains("at most 1000000"), "{err}");
+    // Starting 100,000 threads took most of a minute to fail; a path in a closed mirror with
+    // max_depth 4294967295 never ended.
+    let err = fails(&["render", s, "--threads", "100000"]);
+    assert!(
+        err.contains("--threads must be in 1..=1024, got 100000"),
+        "{err}"
+    );
+    let deep = write(
+        d.path(),
+        "deep.ron",
+        &GOOD.replace("spp: 2)", "spp: 2, max_depth: 4294967295)"),
+    );
+    let err = fails(&["render", deep.to_str().unwrap()]);
+    assert!(
+        err.contains("deep.ron:2:") && err.contains("at most 1024 scattering events"),
+        "{err}"
+    );
 }
 
 #[test]

@@ -36,9 +36,9 @@ pub enum CliError {
         /// Samples per pixel.
         spp: u32,
     },
-    /// `--threads 0`.
-    #[error("--threads must be at least 1")]
-    NoThreads,
+    /// `--threads` outside 1..=[`super::render::MAX_THREADS`].
+    #[error("--threads must be in 1..=1024, got {0}")]
+    Threads(usize),
     /// The pool of worker threads could not be started.
     #[error("cannot start worker threads: {0}")]
     ThreadPool(#[source] rayon::ThreadPoolBuildError),

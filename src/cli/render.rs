@@ -11,6 +11,10 @@ use crate::scene::RenderScene;
 use crate::scene_file::LoadedScene;
 use std::path::{Path, PathBuf};
 
+/// The most worker threads `--threads` may ask for (starting 100,000 threads took most of a
+/// minute to fail).
+pub const MAX_THREADS: usize = 1024;
+
 /// `prism render`: a still image, or a frame series with `--frames`.
 pub(super) fn render(a: RenderArgs) -> Result<(), CliError> {
     let mut extra = Vec::new();
@@ -29,8 +33,10 @@ pub(super) fn render(a: RenderArgs) -> Result<(), CliError> {
     {
         return Err(CliError::TimeLimit(t));
     }
-    if a.threads == Some(0) {
-        return Err(CliError::NoThreads);
+    if let Some(t) = a.threads
+        && !(1..=MAX_THREADS).contains(&t)
+    {
+        return Err(CliError::Threads(t));
     }
     let scene = load_scene(&a.scene, &a.set, &extra)?;
     let stem = a

@@ -306,7 +306,7 @@ fn build_world(scene: schema::Scene, path: &Path, hash: u64) -> Result<LoadedSce
         width: r.width.0,
         height: r.height.0,
         spp: r.spp.0,
-        max_depth: r.max_depth,
+        max_depth: r.max_depth.0,
         seed: r.seed,
         light_sampling: r.integrator.light_sampling,
         rr_depth: r.integrator.rr_depth,

@@ -1,6 +1,6 @@
 //! `render:` settings: image size, samples, depth, seed, filter and the integrator's options.
 
-use super::{ImageDim, Positive, Spp, Wavelengths};
+use super::{ImageDim, MaxDepth, Positive, Spp, Wavelengths};
 use serde::{Deserialize, Serialize};
 
 /// The `render:` settings; every field is optional.
@@ -16,9 +16,10 @@ pub struct Render {
     /// Samples per pixel, >= 1; default 64.
     #[serde(default = "default_spp")]
     pub spp: Spp,
-    /// Scattering events after which a path ends, counted as pbrt counts them; default 12.
+    /// Scattering events after which a path ends, counted as pbrt counts them, 0..=1024;
+    /// default 12.
     #[serde(default = "default_max_depth")]
-    pub max_depth: u32,
+    pub max_depth: MaxDepth,
     /// Sampler seed: different seeds give independent images; default 1.
     #[serde(default = "default_seed")]
     pub seed: u64,
@@ -46,8 +47,8 @@ fn default_height() -> ImageDim {
 fn default_spp() -> Spp {
     Spp(64)
 }
-fn default_max_depth() -> u32 {
-    12
+fn default_max_depth() -> MaxDepth {
+    MaxDepth(12)
 }
 fn default_seed() -> u64 {
     1

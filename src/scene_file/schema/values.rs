@@ -61,6 +61,10 @@ checked_number!(
     /// Image width or height in pixels.
     ImageDim(u32, "u32"), |x: u32| (1..=65536).contains(&x), "in 1..=65536 pixels");
 checked_number!(
+    /// Scattering events after which a path ends: at most 1024, so that a path in a closed
+    /// mirror (whose throughput Russian roulette never lowers) still ends.
+    MaxDepth(u32, "u32"), |x: u32| x <= 1024, "at most 1024 scattering events");
+checked_number!(
     /// Samples per pixel.
     Spp(u32, "u32"), |x: u32| x >= 1, "at least 1 sample per pixel");
 checked_number!(
