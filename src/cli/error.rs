@@ -36,7 +36,7 @@ pub enum CliError {
         /// Samples per pixel.
         spp: u32,
     },
-    /// `--threads` outside 1..=[`super::render::MAX_THREADS`].
+    /// `--threads` outside 1..=1024 (`MAX_THREADS`).
     #[error("--threads must be in 1..=1024, got {0}")]
     Threads(usize),
     /// The pool of worker threads could not be started.
