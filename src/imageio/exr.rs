@@ -113,7 +113,8 @@ pub(super) fn decode_exr(
     path: &Path,
     bytes: Vec<u8>,
 ) -> Result<(Image, Option<ImageMeta>), FilmError> {
-    // The headers first: their data windows decide what the decoder allocates.
+    // The headers first: their data windows decide what the decoder allocates. (Headers
+    // that do not parse are left to the decoder, whose error names the fault.)
     if let Ok(meta) = exr::meta::MetaData::read_from_buffered(Cursor::new(&bytes[..]), false) {
         for h in &meta.headers {
             super::check_read_size(path, h.layer_size.0 as u64, h.layer_size.1 as u64)?;

@@ -147,29 +147,21 @@ pub fn sigmoid<F: Float>(c: &[F; 3], scale: F, lambda: F) -> F {
     s * scale
 }
 
-/// Linear interpolation in a 1 nm table starting at [`LAMBDA_MIN`] (`stride` values per row,
-/// `offset` the column), zero outside the table, as the scalar lookups do.
+/// [`super::RgbIlluminant::illuminant4`] (D65 of luminance 1) at wavelength `lambda` of every
+/// lane: linear interpolation in its 1 nm table from [`LAMBDA_MIN`], zero outside the table, as
+/// the scalar lookup does.
 #[inline(always)]
-fn table_1nm<F: Float>(table: &[f32], rows: usize, stride: u32, offset: u32, lambda: F) -> F {
+pub fn illuminant<F: Float>(lambda: F) -> F {
+    let rows = ILLUMINANT_1NM.len();
     let x = lambda - F::splat(LAMBDA_MIN);
     let inside = x.ge(F::zero()) & x.le(F::splat((rows - 1) as f32));
     let x = F::select(inside, x, F::zero());
     let fi = x.floor().min(F::splat((rows - 2) as f32));
     let f = x - fi;
-    let i = fi
-        .to_i32_bits()
-        .wrapping_mul(F::U32::splat(stride))
-        .wrapping_add(F::U32::splat(offset));
-    let a = F::gather(table, i);
-    let b = F::gather(table, i.wrapping_add(F::U32::splat(stride)));
+    let i = fi.to_i32_bits();
+    let a = F::gather(&ILLUMINANT_1NM, i);
+    let b = F::gather(&ILLUMINANT_1NM, i.wrapping_add(F::U32::splat(1)));
     F::select(inside, a + (b - a) * f, F::zero())
-}
-
-/// [`super::RgbIlluminant::illuminant4`] (D65 of luminance 1) at wavelength `lambda` of every
-/// lane.
-#[inline(always)]
-pub fn illuminant<F: Float>(lambda: F) -> F {
-    table_1nm(&ILLUMINANT_1NM, ILLUMINANT_1NM.len(), 1, 0, lambda)
 }
 
 #[cfg(test)]
