@@ -290,8 +290,89 @@ fn kd_packet(c: &mut Criterion) {
     g.finish();
 }
 
+struct TextureLookups<'a> {
+    albedo: &'a prism::texture::AlbedoTexture,
+    uv: &'a [[f32; 4096]; 2],
+    lanes: bool,
+    out: &'a mut [f32],
+}
+
+impl LaneKernel for TextureLookups<'_> {
+    type Output = ();
+    #[inline(always)]
+    fn run<F: Float>(self) {
+        let all = F::zero().eq(F::zero());
+        for i in (0..self.out.len()).step_by(F::WIDTH) {
+            let (u, v) = (F::load(&self.uv[0][i..]), F::load(&self.uv[1][i..]));
+            let c = if self.lanes {
+                self.albedo.eval_lanes(u, v, all)
+            } else {
+                // The alternative the surface stage had: one scalar lookup per lane.
+                prism::simd::V3::from_fn(|l| {
+                    self.albedo.eval(glam::Vec2::new(u.lane(l), v.lane(l)))
+                })
+            };
+            (c.x + c.y + c.z).store(&mut self.out[i..]);
+        }
+    }
+}
+
+/// An albedo texture's lookups for a packet: all lanes at once (gathers for an image) against
+/// one scalar lookup per lane, over 4,096 random uv.
+fn texture_lookup(c: &mut Criterion) {
+    use prism::texture::{AlbedoTexture, Checker, TexImage, Wrap};
+    let (w, h) = (1024u32, 512u32);
+    let mut x = 0x2545_f491_u32;
+    let mut next = move || {
+        x ^= x << 13;
+        x ^= x >> 17;
+        x ^= x << 5;
+        (x >> 8) as f32 / (1u32 << 24) as f32
+    };
+    let pixels = (0..w * h).map(|_| [next(), next(), next()]).collect();
+    let image = AlbedoTexture::Image {
+        image: std::sync::Arc::new(TexImage::from_pixels(w, h, pixels)),
+        wrap: Wrap::Repeat,
+    };
+    let checker = AlbedoTexture::Checker(Checker {
+        a: glam::Vec3::splat(0.8),
+        b: glam::Vec3::splat(0.2),
+        size: 0.05,
+    });
+    let mut uv = Box::new([[0.0f32; 4096]; 2]);
+    for k in 0..4096 {
+        uv[0][k] = next() * 2.0 - 0.5;
+        uv[1][k] = next() * 2.0 - 0.5;
+    }
+    let mut out = vec![0.0f32; 4096];
+    let mut g = c.benchmark_group("texture_lookup");
+    g.throughput(Throughput::Elements(4096));
+    for (name, albedo) in [("image_1024x512", &image), ("checker", &checker)] {
+        for (form, lanes) in forms() {
+            for (how, in_lanes) in [("lanes", true), ("per_lane", false)] {
+                g.bench_function(format!("{name}_{how}_{form}"), |bench| {
+                    bench.iter(|| {
+                        simd::dispatch(
+                            lanes,
+                            TextureLookups {
+                                albedo,
+                                uv: &uv,
+                                lanes: in_lanes,
+                                out: &mut out,
+                            },
+                        );
+                        black_box(out[7])
+                    })
+                });
+            }
+        }
+    }
+    g.finish();
+}
+
 criterion_group!(
     benches,
+    texture_lookup,
     lane_math,
     sample_generation,
     render_widths,

@@ -703,3 +703,117 @@ Scene(
         }
     }
 }
+
+struct TextureKernel<'a> {
+    albedos: &'a [prism::texture::AlbedoTexture],
+    uvs: &'a [(f32, f32)],
+}
+
+impl LaneKernel for TextureKernel<'_> {
+    type Output = Vec<Vec<u32>>;
+    #[inline(always)]
+    fn run<F: Float>(self) -> Vec<Vec<u32>> {
+        let (albedos, uvs) = (self.albedos, self.uvs);
+        chunks::<F, u32>(uvs.len(), |idx| {
+            let u = F::from_fn(|l| uvs[idx(l)].0);
+            let v = F::from_fn(|l| uvs[idx(l)].1);
+            let all = F::splat(0.0).eq(F::splat(0.0));
+            let vals: Vec<F> = albedos
+                .iter()
+                .flat_map(|a| {
+                    let c = a.eval_lanes(u, v, all);
+                    [c.x, c.y, c.z]
+                })
+                .collect();
+            bits_of(&vals)
+        })
+    }
+}
+
+#[test]
+fn lane_texture_lookups_are_the_scalar_lookups() {
+    use prism::texture::{AlbedoTexture, Bricks, Checker, TexImage, Wrap};
+    use std::sync::Arc;
+    let mut rng = SplitMix(0x7e_c5);
+    // Odd sizes, so no index arithmetic hides behind a power of two.
+    let (w, h) = (5, 3);
+    let pixels = (0..w * h)
+        .map(|_| [rng.unit() as f32, rng.unit() as f32, rng.unit() as f32])
+        .collect();
+    let image = Arc::new(TexImage::from_pixels(w, h, pixels));
+    let mut albedos: Vec<AlbedoTexture> = [Wrap::Repeat, Wrap::Clamp, Wrap::Mirror]
+        .into_iter()
+        .map(|wrap| AlbedoTexture::Image {
+            image: image.clone(),
+            wrap,
+        })
+        .collect();
+    albedos.push(AlbedoTexture::Checker(Checker {
+        a: Vec3::new(0.9, 0.8, 0.7),
+        b: Vec3::new(0.1, 0.2, 0.3),
+        size: 0.3,
+    }));
+    albedos.push(AlbedoTexture::Bricks(Bricks {
+        brick: Vec3::new(0.5, 0.15, 0.1),
+        mortar: Vec3::new(0.8, 0.8, 0.75),
+        size: Vec2::new(0.4, 0.2),
+        joint: 0.02,
+    }));
+    // Every special coordinate against every other, then random ones over several periods
+    // and texel centres and edges exactly.
+    let special = [
+        0.0,
+        -0.0,
+        1.0,
+        -1.0,
+        2.0,
+        0.5,
+        -1e-10,
+        1e-10,
+        -1e-45,
+        1e-45,
+        -f32::MIN_POSITIVE,
+        1.0 - f32::EPSILON / 2.0,
+        0.1 / 5.0,
+        0.5 / 3.0,
+        1e30,
+        -1e30,
+        f32::MAX,
+        f32::MIN,
+        f32::INFINITY,
+        f32::NEG_INFINITY,
+        f32::NAN,
+    ];
+    let mut uvs: Vec<(f32, f32)> = special
+        .iter()
+        .flat_map(|&a| special.iter().map(move |&b| (a, b)))
+        .collect();
+    uvs.extend((0..20_000).map(|_| {
+        (
+            (rng.unit() * 8.0 - 4.0) as f32,
+            (rng.unit() * 8.0 - 4.0) as f32,
+        )
+    }));
+    uvs.extend((0..=2 * w).map(|k| (k as f32 / (2 * w) as f32, k as f32 / (2 * h) as f32)));
+    let want: Vec<Vec<u32>> = uvs
+        .iter()
+        .map(|&(u, v)| {
+            albedos
+                .iter()
+                .flat_map(|a| a.eval(Vec2::new(u, v)).to_array().map(f32::to_bits))
+                .collect()
+        })
+        .collect();
+    for lanes in forms() {
+        let got = simd::dispatch(
+            lanes,
+            TextureKernel {
+                albedos: &albedos,
+                uvs: &uvs,
+            },
+        );
+        for (k, (g, w)) in got.iter().zip(&want).enumerate() {
+            assert_eq!(g, w, "{} at {:?}", lanes.describe(), uvs[k]);
+        }
+    }
+}

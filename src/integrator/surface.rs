@@ -12,7 +12,7 @@ use crate::scene::Hit;
 use crate::scene::packet::PacketHit;
 use crate::scene::primitives::emitted;
 use crate::simd::{Float, Mask, UInt, V3};
-use glam::Vec3;
+use glam::{Vec2, Vec3};
 
 /// Per-lane material classes after the surface stage.
 pub(super) const CLASS_NONE: u32 = 0;
@@ -43,28 +43,42 @@ pub(super) struct Surface<F: Float, const N: usize> {
     pub(super) le_w: F,
 }
 
-/// The surface at `hit` with its material after textures: the albedo texture modulates the
-/// material (and is returned for spectral upsampling), a normal map tilts the shading normal.
+/// Where a hit's albedo texture stands after [`surface_material`].
+pub(crate) enum Albedo {
+    /// No albedo texture (or textures off).
+    None,
+    /// Looked up already (patterns without a lane form).
+    Now(Vec3),
+    /// To be looked up in lanes: the texture's index and the surface uv.
+    Later(u32, Vec2),
+}
+
+/// The surface at `hit` with its untextured material; a normal map tilts the shading normal.
+/// Albedo textures with a lane form (images, checkerboards) are left to the caller, which
+/// looks them up for a packet's lanes at once; other patterns are evaluated here.
 #[inline(always)]
 pub(crate) fn surface_material<const MOTION: bool>(
     ctx: &Ctx,
     ray: &Ray,
     hit: &Hit,
     time: f32,
-) -> (crate::geometry::SurfacePoint, Material, Option<Vec3>) {
+) -> (crate::geometry::SurfacePoint, Material, Albedo) {
     let prims = &ctx.scene.prims;
     let mut sp = prims.surface_at::<MOTION>(ray, hit, time);
-    let mut material = prims.materials[prims.material[hit.prim as usize] as usize];
-    let mut tex_albedo = None;
+    let material = prims.materials[prims.material[hit.prim as usize] as usize];
+    let mut albedo = Albedo::None;
     if (ctx.textures || ctx.normal_maps)
         && let Some(tex) = prims.texture_of(hit.prim)
     {
         let (uv, dpdu, dpdv) = prims.uv_frame::<MOTION>(ray, hit, &sp, time);
         if ctx.textures
-            && let Some(a) = tex.albedo(uv)
+            && let Some(a) = &tex.albedo
         {
-            material = material.modulated(a);
-            tex_albedo = Some(a);
+            albedo = if a.has_lane_form() {
+                Albedo::Later(prims.texture[hit.prim as usize], uv)
+            } else {
+                Albedo::Now(a.eval(tex.map_uv(uv)))
+            };
         }
         if ctx.normal_maps && tex.normal_map.is_some() {
             // As pbrt does: the perturbed normal is turned to the geometric normal's side;
@@ -73,11 +87,84 @@ pub(crate) fn surface_material<const MOTION: bool>(
             sp.ns = if ns.dot(sp.n) < 0.0 { -ns } else { ns };
         }
     }
-    (sp, material, tex_albedo)
+    (sp, material, albedo)
 }
 
-/// What lies at each lane's closest hit, one lane at a time: the surface, its textures and
-/// material, and for emitters their radiance with its MIS weight.
+/// One lane's hit as the material stage needs it.
+#[derive(Clone, Copy)]
+struct LaneHit {
+    mat: u32,
+    prim: u32,
+    /// The geometric normal (not turned to the ray) and the point, for an emitter.
+    n: Vec3,
+    p: Vec3,
+}
+
+/// Per-lane results of the material stage, filled one lane at a time.
+struct Shading<T: Transport> {
+    color: T::Colours,
+    le: T::Colours,
+    class: [u32; MAX_W],
+    le_w: [f32; MAX_W],
+    emit_bits: u32,
+}
+
+impl<T: Transport> Shading<T> {
+    /// Lane i's class and colours from its material, texture-modulated by `albedo`.
+    #[inline(always)]
+    #[allow(clippy::too_many_arguments)]
+    fn finish<F: Float, const N: usize, const MOTION: bool, const MEDIA: bool>(
+        &mut self,
+        ctx: &Ctx,
+        st: &Paths<F, T, N>,
+        i: usize,
+        h: LaneHit,
+        material: Material,
+        albedo: Option<Vec3>,
+    ) where
+        T: Transport<S: ChannelArray<N>>,
+    {
+        let textured = albedo.is_some();
+        match material {
+            Material::Diffuse { albedo } => {
+                self.class[i] = CLASS_DIFFUSE;
+                T::set_reflectance(&mut self.color, i, ctx, h.mat, albedo, textured);
+            }
+            Material::Mirror { tint } => {
+                self.class[i] = CLASS_MIRROR;
+                T::set_reflectance(&mut self.color, i, ctx, h.mat, tint, textured);
+            }
+            Material::Dielectric { .. } => self.class[i] = CLASS_DIELECTRIC,
+            Material::Light { .. } => {
+                let radiance = emitted(&material, h.n, -st.d.lane(i));
+                if radiance != Vec3::ZERO {
+                    self.emit_bits |= 1 << i;
+                    T::set_emission(&mut self.le, i, ctx, h.mat, radiance, albedo, &st.lam);
+                    let (depth, specular) = (st.depth.lane(i), st.specular.lane(i));
+                    self.le_w[i] = if depth == 0 || specular || !ctx.nee {
+                        1.0
+                    } else {
+                        let pdf = ctx.scene.lights.pdf_area::<MOTION>(
+                            &ctx.scene.prims,
+                            h.prim,
+                            st.prev_p.lane(i),
+                            h.p,
+                            h.n,
+                            st.time.lane(i),
+                        );
+                        power_heuristic::<f32>(st.prev_pdf.lane(i), pdf)
+                    };
+                }
+            }
+            // Only MEDIA scenes have boundaries.
+            Material::Boundary => self.class[i] = if MEDIA { CLASS_BOUNDARY } else { CLASS_NONE },
+        }
+    }
+}
+
+/// What lies at each lane's closest hit: the surface one lane at a time, then the albedo
+/// textures for all lanes that share one at once (an image gathers its texels), then each
+/// lane's material, and for emitters their radiance with its MIS weight.
 #[inline(always)]
 pub(super) fn surfaces<
     F: Float,
@@ -94,12 +181,20 @@ pub(super) fn surfaces<
     let scene = ctx.scene;
     let prims = &scene.prims;
     let (mut p, mut n, mut ns) = (Scratch3::new(), Scratch3::new(), Scratch3::new());
-    let (mut color, mut le) = (T::colours(), T::colours());
-    let mut class = [CLASS_NONE; MAX_W];
+    let mut shade = Shading::<T> {
+        color: T::colours(),
+        le: T::colours(),
+        class: [CLASS_NONE; MAX_W],
+        le_w: [0.0; MAX_W],
+        emit_bits: 0,
+    };
     let mut mats = [0u32; MAX_W];
     let mut prim = [0u32; MAX_W];
-    let mut le_w = [0.0f32; MAX_W];
-    let (mut hit_bits, mut front_bits, mut emit_bits) = (0u32, 0u32, 0u32);
+    let (mut hit_bits, mut front_bits) = (0u32, 0u32);
+    // Lanes whose albedo is looked up in lanes after this loop: their texture and uv.
+    let mut later = 0u32;
+    let mut tex = [0u32; MAX_W];
+    let (mut tu, mut tv) = ([0.0f32; MAX_W], [0.0f32; MAX_W]);
     let found = (hits.hit & at).bits();
     for i in 0..F::WIDTH {
         if found >> i & 1 == 0 {
@@ -114,44 +209,62 @@ pub(super) fn surfaces<
         hit_bits |= 1 << i;
         mats[i] = mat;
         prim[i] = hit.prim;
-        let (sp, material, tex_albedo) = surface_material::<MOTION>(ctx, &ray, &hit, time);
+        let (sp, material, albedo) = surface_material::<MOTION>(ctx, &ray, &hit, time);
         p.set(i, sp.p);
         n.set(i, sp.facing());
         ns.set(i, sp.shading_facing());
         front_bits |= (sp.front as u32) << i;
-        match material {
-            Material::Diffuse { albedo } => {
-                class[i] = CLASS_DIFFUSE;
-                T::set_reflectance(&mut color, i, ctx, mat, albedo, tex_albedo.is_some());
+        let h = LaneHit {
+            mat,
+            prim: hit.prim,
+            n: sp.n,
+            p: sp.p,
+        };
+        match albedo {
+            Albedo::None => shade.finish::<F, N, MOTION, MEDIA>(ctx, st, i, h, material, None),
+            Albedo::Now(a) => {
+                let m = material.modulated(a);
+                shade.finish::<F, N, MOTION, MEDIA>(ctx, st, i, h, m, Some(a));
             }
-            Material::Mirror { tint } => {
-                class[i] = CLASS_MIRROR;
-                T::set_reflectance(&mut color, i, ctx, mat, tint, tex_albedo.is_some());
+            Albedo::Later(t, uv) => {
+                later |= 1 << i;
+                (tex[i], tu[i], tv[i]) = (t, uv.x, uv.y);
             }
-            Material::Dielectric { .. } => class[i] = CLASS_DIELECTRIC,
-            Material::Light { .. } => {
-                let radiance = emitted(&material, sp.n, -ray.d);
-                if radiance != Vec3::ZERO {
-                    emit_bits |= 1 << i;
-                    T::set_emission(&mut le, i, ctx, mat, radiance, tex_albedo, &st.lam);
-                    let (depth, specular) = (st.depth.lane(i), st.specular.lane(i));
-                    le_w[i] = if depth == 0 || specular || !ctx.nee {
-                        1.0
-                    } else {
-                        let pdf = scene.lights.pdf_area::<MOTION>(
-                            prims,
-                            hit.prim,
-                            st.prev_p.lane(i),
-                            sp.p,
-                            sp.n,
-                            time,
-                        );
-                        power_heuristic::<f32>(st.prev_pdf.lane(i), pdf)
-                    };
-                }
+        }
+    }
+    // One lane lookup per texture among the packet's hits (usually one or two).
+    let (u, v) = (F::load(&tu), F::load(&tv));
+    while later != 0 {
+        let t = tex[later.trailing_zeros() as usize];
+        let mut same = 0u32;
+        for (i, &ti) in tex.iter().enumerate().take(F::WIDTH) {
+            same |= u32::from(later >> i & 1 != 0 && ti == t) << i;
+        }
+        later &= !same;
+        let Some(a) = prims.textures[t as usize].albedo_lanes(u, v, mask_from_bits::<F>(same))
+        else {
+            continue;
+        };
+        for i in 0..F::WIDTH {
+            if same >> i & 1 == 0 {
+                continue;
             }
-            // Only MEDIA scenes have boundaries.
-            Material::Boundary => class[i] = if MEDIA { CLASS_BOUNDARY } else { CLASS_NONE },
+            let ai = a.lane(i);
+            // The surface as the loop above left it: the geometric normal from the facing
+            // one and the side.
+            let facing = Vec3::new(n.x[i], n.y[i], n.z[i]);
+            let h = LaneHit {
+                mat: mats[i],
+                prim: prim[i],
+                n: if front_bits >> i & 1 != 0 {
+                    facing
+                } else {
+                    -facing
+                },
+                p: Vec3::new(p.x[i], p.y[i], p.z[i]),
+            };
+            let m = prims.materials[mats[i] as usize].modulated(ai);
+            shade.finish::<F, N, MOTION, MEDIA>(ctx, st, i, h, m, Some(ai));
         }
     }
     Surface {
@@ -160,16 +273,16 @@ pub(super) fn surfaces<
         nf: n.v3(),
         nsf: ns.v3(),
         front: mask_from_bits::<F>(front_bits),
-        class: U::<F>::from_fn(|i| class[i]),
-        color: T::eval(&color, &st.lam),
+        class: U::<F>::from_fn(|i| shade.class[i]),
+        color: T::eval(&shade.color, &st.lam),
         mat: mats,
         prim,
-        emits: mask_from_bits::<F>(emit_bits),
-        le: if emit_bits != 0 {
-            T::eval(&le, &st.lam)
+        emits: mask_from_bits::<F>(shade.emit_bits),
+        le: if shade.emit_bits != 0 {
+            T::eval(&shade.le, &st.lam)
         } else {
             C::<F, N>::splat(F::zero())
         },
-        le_w: F::load(&le_w),
+        le_w: F::load(&shade.le_w),
     }
 }

@@ -12,6 +12,7 @@ use serde::{Deserialize, Serialize};
 
 pub use crate::imageio::ColorSpace;
 use crate::imageio::{FilmError, decode_raster, read_image};
+use crate::simd::{Float, UInt, V3};
 
 /// How texture coordinates outside [0, 1] are folded back onto the image.
 ///
@@ -276,6 +277,28 @@ impl TexImage {
         bottom.lerp(top, fy)
     }
 
+    /// [`bilinear`](Self::bilinear) for every lane at once, bit for bit: the texel indices
+    /// are folded in lanes and the twelve texel values gathered, so a packet's lookups share
+    /// their instructions. Every lane is looked up (inactive ones too: any coordinate gives
+    /// an index inside the image).
+    #[inline(always)]
+    pub fn bilinear_lanes<F: Float>(&self, u: F, v: F, wrap: Wrap) -> V3<F> {
+        let (x0, x1, fx) = axis_lanes(u, self.width, wrap);
+        let (y0, y1, fy) = axis_lanes(v, self.height, wrap);
+        let w = F::U32::splat(self.width);
+        // Axis indices count from the bottom; storage rows from the top. Indices stay below
+        // 3·2²⁸ (the size bound of decoded images), so u32 arithmetic cannot wrap.
+        let last = F::U32::splat(self.height - 1);
+        let (r0, r1) = (
+            last.wrapping_sub(y0).wrapping_mul(w),
+            last.wrapping_sub(y1).wrapping_mul(w),
+        );
+        let flat = self.pixels.as_flattened();
+        let bottom = lerp_lanes(texel_lanes(flat, x0, r0), texel_lanes(flat, x1, r0), fx);
+        let top = lerp_lanes(texel_lanes(flat, x0, r1), texel_lanes(flat, x1, r1), fx);
+        lerp_lanes(bottom, top, fy)
+    }
+
     /// Rec. 709 luminance of the filtered colour.
     #[inline]
     pub fn luminance(&self, uv: Vec2, wrap: Wrap) -> f32 {
@@ -302,6 +325,81 @@ fn axis(t: f32, n: u32, wrap: Wrap) -> (u32, u32, f32) {
     let frac = x - base;
     let i = base as i64;
     (fold(i, n, wrap), fold(i + 1, n, wrap), frac)
+}
+
+/// The texels at column `i` of storage row offset `r` (a row's first pixel) in every lane.
+// Helpers here are functions, not closures: a closure is not reliably inlined into the
+// lane kernel's entry point and would then run its lane operations outside it.
+#[inline(always)]
+fn texel_lanes<F: Float>(flat: &[f32], i: F::U32, r: F::U32) -> V3<F> {
+    let k = r.wrapping_add(i).wrapping_mul(F::U32::splat(3));
+    V3::new(
+        F::gather(flat, k),
+        F::gather(flat, k.wrapping_add(F::U32::splat(1))),
+        F::gather(flat, k.wrapping_add(F::U32::splat(2))),
+    )
+}
+
+/// glam's `lerp`, `a·(1 − s) + b·s`, unfused like the scalar lookup.
+#[inline(always)]
+fn lerp_lanes<F: Float>(a: V3<F>, b: V3<F>, s: F) -> V3<F> {
+    let t = F::one() - s;
+    V3::new(a.x * t + b.x * s, a.y * t + b.y * s, a.z * t + b.z * s)
+}
+
+/// `t.rem_euclid(m)` for `m` = 1 or 2 in every lane, bit for bit up to the sign of a zero
+/// result (which no caller can see: it is scaled and offset next).
+#[inline(always)]
+pub(crate) fn rem_euclid_lanes<F: Float>(t: F, m: f32) -> F {
+    let r = t - F::splat(m) * (t * F::splat(1.0 / m)).floor();
+    // A negative subnormal whose half rounds to −0 is left negative; `rem_euclid` adds m.
+    F::select(r.lt(F::zero()), r + F::splat(m), r)
+}
+
+/// [`axis`] in lanes: the same arithmetic, with the texel indices folded by [`fold_lanes`].
+#[inline(always)]
+fn axis_lanes<F: Float>(t: F, n: u32, wrap: Wrap) -> (F::U32, F::U32, F) {
+    let t = F::select(t.is_finite(), t, F::zero());
+    let t = match wrap {
+        Wrap::Repeat => rem_euclid_lanes(t, 1.0),
+        Wrap::Mirror => rem_euclid_lanes(t, 2.0),
+        Wrap::Clamp => t.clamp(F::zero(), F::one()),
+    };
+    let x = t * F::splat(n as f32) - F::splat(0.5);
+    let base = x.floor();
+    let frac = x - base;
+    // t ∈ [0, 2] and n ≤ 2²⁴, so base ∈ [−1, 2n − 1] is an exact integer.
+    let i = base.to_i32_bits();
+    let i1 = i.wrapping_add(F::U32::splat(1));
+    (
+        fold_lanes::<F>(i, n, wrap),
+        fold_lanes::<F>(i1, n, wrap),
+        frac,
+    )
+}
+
+/// [`fold`] for indices in [−1, 2n] (all [`axis_lanes`] produces), as i32 lanes.
+#[inline(always)]
+fn fold_lanes<F: Float>(i: F::U32, n: u32, wrap: Wrap) -> F::U32 {
+    let zero = F::U32::splat(0);
+    let nn = F::U32::splat(n);
+    let negative = i.lt_i32(zero);
+    match wrap {
+        Wrap::Repeat => {
+            let j = F::U32::select(negative, i.wrapping_add(nn), i);
+            F::U32::select(j.lt_i32(nn), j, j.wrapping_sub(nn))
+        }
+        Wrap::Clamp => {
+            let j = F::U32::select(negative, zero, i);
+            F::U32::select(j.lt_i32(nn), j, F::U32::splat(n - 1))
+        }
+        Wrap::Mirror => {
+            let two = F::U32::splat(2 * n);
+            let m = F::U32::select(negative, i.wrapping_add(two), i);
+            let m = F::U32::select(m.lt_i32(two), m, m.wrapping_sub(two));
+            F::U32::select(m.lt_i32(nn), m, F::U32::splat(2 * n - 1).wrapping_sub(m))
+        }
+    }
 }
 
 #[inline]

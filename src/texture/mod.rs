@@ -15,6 +15,7 @@
 pub mod image_tex;
 pub mod procedural;
 
+use crate::simd::{Float, Mask, V3};
 use glam::{Vec2, Vec3};
 use std::sync::Arc;
 
@@ -48,6 +49,32 @@ impl AlbedoTexture {
             Self::Checker(c) => c.eval(uv),
             Self::Bricks(b) => b.eval(uv),
             Self::Wood(w) => w.eval(uv),
+        }
+    }
+
+    /// Whether [`eval_lanes`](Self::eval_lanes) shares its work between lanes (images and
+    /// checkerboards); bricks and wood are cheaper looked up one lane at a time as they are
+    /// met.
+    #[inline]
+    pub fn has_lane_form(&self) -> bool {
+        matches!(self, Self::Image { .. } | Self::Checker(_))
+    }
+
+    /// [`eval`](Self::eval) for the lanes in `active` at once, bit for bit: images gather
+    /// their texels and checkerboards compare in lanes; bricks and wood are looked up one
+    /// active lane at a time (inactive lanes are zero for those, unspecified for the rest).
+    #[inline(always)]
+    pub fn eval_lanes<F: Float>(&self, u: F, v: F, active: F::Mask) -> V3<F> {
+        match self {
+            Self::Image { image, wrap } => image.bilinear_lanes(u, v, *wrap),
+            Self::Checker(c) => c.eval_lanes(u, v),
+            Self::Bricks(_) | Self::Wood(_) => V3::from_fn(|i| {
+                if active.lane(i) {
+                    self.eval(Vec2::new(u.lane(i), v.lane(i)))
+                } else {
+                    Vec3::ZERO
+                }
+            }),
         }
     }
 
@@ -245,6 +272,17 @@ impl Texture {
     #[inline]
     pub fn albedo(&self, uv: Vec2) -> Option<Vec3> {
         self.albedo.as_ref().map(|a| a.eval(self.map_uv(uv)))
+    }
+
+    /// [`albedo`](Self::albedo) in lanes, for a texture known to have one (`None` otherwise):
+    /// surface coordinates `(u, v)`, lanes outside `active` unspecified.
+    #[inline(always)]
+    pub fn albedo_lanes<F: Float>(&self, u: F, v: F, active: F::Mask) -> Option<V3<F>> {
+        let a = self.albedo.as_ref()?;
+        // `uv * scale + offset` as glam computes it: multiply, then add (unfused).
+        let u = u * F::splat(self.scale.x) + F::splat(self.offset.x);
+        let v = v * F::splat(self.scale.y) + F::splat(self.offset.y);
+        Some(a.eval_lanes(u, v, active))
     }
 
     /// Unit tangent-space normal at surface coordinates `uv`; +z without a normal map (or

@@ -5,6 +5,8 @@
 //! as a real relief of that shape would on a surface mapped without stretching. Every
 //! function is total: NaN or infinite coordinates are treated as 0, and nothing allocates.
 
+use super::image_tex::rem_euclid_lanes;
+use crate::simd::{Float, V3};
 use glam::{Vec2, Vec3};
 
 /// Replaces non-finite coordinates by 0 so patterns never see NaN.
@@ -48,6 +50,20 @@ impl Checker {
     #[inline]
     pub fn eval(&self, uv: Vec2) -> Vec3 {
         if self.is_a(uv) { self.a } else { self.b }
+    }
+
+    /// [`eval`](Self::eval) for every lane at once, bit for bit.
+    #[inline(always)]
+    pub fn eval_lanes<F: Float>(&self, u: F, v: F) -> V3<F> {
+        let sum = self.parity_lanes(u) + self.parity_lanes(v);
+        V3::select(sum.ne(F::one()), V3::splat(self.a), V3::splat(self.b))
+    }
+
+    /// `floor(x / size) mod 2` as [`is_a`](Self::is_a) computes it, in lanes.
+    #[inline(always)]
+    fn parity_lanes<F: Float>(&self, x: F) -> F {
+        let x = F::select(x.is_finite(), x, F::zero());
+        rem_euclid_lanes((x / F::splat(self.size)).floor(), 2.0)
     }
 
     /// A checkerboard is a flat print: constant height.
