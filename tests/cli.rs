@@ -250,6 +250,139 @@ fn non_regular_files_are_refused_without_reading_them() {
 /// Sample and frame numbers are 32-bit: ranges that would wrap (and silently repeat samples
 /// or render nothing) or list billions of frames are refused.
 #[test]
+fn the_film_size_is_bounded_before_it_is_allocated() {
+    let d = tempfile::tempdir().unwrap();
+    // 65536² wrapped the u32 pixel count to 0; 16384² is the largest film accepted.
+    let big = write(
+        d.path(),
+        "big.ron",
+        &GOOD.replace("width: 8, height: 6", "width: 65536, height: 65536"),
+    );
+    let err = fails(&["render", big.to_str().unwrap()]);
+    assert!(
+        err.contains("big.ron:2:")
+            && err.contains("4294967296 pixels")
+            && err.contains("268435456"),
+        "{err}"
+    );
+    let good = write(d.path(), "g.ron", GOOD);
+    let g = good.to_str().unwrap();
+    let err = fails(&["render", g, "--size", "16385x16384"]);
+    assert!(
+        err.contains("16385 × 16384") && err.contains("268435456"),
+        "{err}"
+    );
+    let err = fails(&[
+        "render",
+        g,
+        "--set",
+        "render.width=65536",
+        "--set",
+        "render.height=5000",
+    ]);
+    assert!(
+        err.contains("--set render.height") && err.contains("268435456"),
+        "{err}"
+    );
+    // Within the bound, nothing is refused (a thin strip, to stay fast).
+    let out = prism()
+        .args([
+            "render", g, "--quiet", "--spp", "1", "--size", "65536x1", "-o",
+        ])
+        .arg(d.path().join("strip.exr"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+}
+
+#[test]
+fn checks_of_several_fields_name_the_field_at_fault() {
+    let d = tempfile::tempdir().unwrap();
+    // These checks run when their group closes, after its last field, which the message
+    // named instead (`g` for a negative sigma_a, `radius` for a zero normal).
+    for (from, to, field) in [
+        (
+            "material: Diffuse(albedo: Rgb(0.5, 0.5, 0.5))",
+            "medium: (sigma_a: Rgb(-1.0, 0.0, 0.0), sigma_s: Rgb(0.1, 0.1, 0.1), g: 0.3)",
+            "field `sigma_a`",
+        ),
+        (
+            "shape: Sphere(center: (0.0, 0.0, 0.0), radius: 1.0)",
+            "shape: Disk(center: (0.0, 0.0, 0.0), normal: (0.0, 0.0, 0.0), radius: 1.0)",
+            "field `normal`",
+        ),
+        (
+            "material: Diffuse(albedo: Rgb(0.5, 0.5, 0.5))",
+            "material: Light(emission: Blackbody(kelvin: 6500.0, scale: -1.0))",
+            "field `scale`",
+        ),
+    ] {
+        let scene = write(d.path(), "f.ron", &GOOD.replace(from, to));
+        let err = fails(&["render", scene.to_str().unwrap()]);
+        assert!(
+            err.contains("f.ron:") && err.contains("entity \"ball\"") && err.contains(field),
+            "{err}"
+        );
+        assert_eq!(err.matches("field `").count(), 1, "{err}");
+    }
+}
+
+#[test]
+fn negative_exposure_is_a_value_and_a_non_finite_one_is_refused() {
+    let d = tempfile::tempdir().unwrap();
+    let good = write(d.path(), "g.ron", GOOD);
+    let out = d.path().join("dark.png");
+    let run = prism()
+        .args([
+            "render",
+            good.to_str().unwrap(),
+            "--quiet",
+            "--exposure",
+            "-1",
+            "-o",
+        ])
+        .arg(&out)
+        .output()
+        .unwrap();
+    assert!(
+        run.status.success(),
+        "{}",
+        String::from_utf8_lossy(&run.stderr)
+    );
+    assert!(out.exists());
+    let err = fails(&["render", good.to_str().unwrap(), "--exposure", "nan"]);
+    assert!(err.contains("-100..=100"), "{err}");
+}
+
+#[test]
+fn names_are_escaped_and_cut_in_messages() {
+    let d = tempfile::tempdir().unwrap();
+    // An escape sequence in a name must not reach the terminal, and a long name must not
+    // make a long line.
+    let long = "x".repeat(100_000);
+    for (name, shown) in [
+        ("evil\u{1b}[31mred", "evil\\u{1b}[31mred"),
+        (long.as_str(), "(100000 characters)"),
+    ] {
+        let scene = write(
+            d.path(),
+            "n.ron",
+            &GOOD
+                .replace("name: \"ball\"", &format!("name: \"{name}\""))
+                .replace("radius: 1.0", "radius: -1.0"),
+        );
+        let err = fails(&["render", scene.to_str().unwrap()]);
+        assert!(!err.contains('\u{1b}'), "{err:?}");
+        assert!(err.contains(shown), "{err:?}");
+        assert!(err.len() < 400, "{} bytes", err.len());
+    }
+}
+
+#[test]
 fn sample_and_frame_ranges_cannot_wrap() {
     let d = tempfile::tempdir().unwrap();
     let scene = write(d.path(), "s.ron", GOOD);
@@ -315,7 +448,7 @@ fn bad_values_are_refused_with_their_valid_range() {
     );
     let err = fails(&["render", scene.to_str().unwrap()]);
     assert!(
-        err.contains("kelvin") && err.contains("500..=100000"),
+        err.contains("field `kelvin`") && err.contains("500..=100000"),
         "{err}"
     );
     let scene = with("p.ron", "material: Dielectric(ior: Preset(Glass))");

@@ -87,7 +87,7 @@ pub(super) struct RenderArgs {
     #[arg(long, default_value_t = 0)]
     pub(super) sample_offset: u32,
     /// PNG exposure in stops.
-    #[arg(long, default_value_t = 0.0)]
+    #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = parse_exposure)]
     pub(super) exposure: f32,
     /// Render one frame (7) or a range in Rust syntax: 0..24 is frames 0 to 23 (the end is
     /// excluded), 0..=23 the same; `-o` names frames with a run of '#', e.g.
@@ -201,7 +201,19 @@ fn parse_size(s: &str) -> Result<(u32, u32), String> {
             ))
         }
     };
-    Ok((p(w)?, p(h)?))
+    let (w, h) = (p(w)?, p(h)?);
+    crate::scene_file::schema::check_film_size(w, h)?;
+    Ok((w, h))
+}
+
+/// `--exposure`: a finite number of stops in -100..=100 (2¹⁰⁰ already saturates any film).
+fn parse_exposure(s: &str) -> Result<f32, String> {
+    match s.trim().parse::<f32>() {
+        Ok(x) if x.is_finite() && (-100.0..=100.0).contains(&x) => Ok(x),
+        _ => Err(format!(
+            "expected stops in -100..=100, e.g. -1.5, got '{s}'"
+        )),
+    }
 }
 
 /// `KEY=VALUE` of `--set`, both trimmed.

@@ -60,6 +60,9 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<(u32, u64), CliError> {
     for p in parts {
         let (img, meta) = film::read_image(p)?;
         let meta = meta.ok_or_else(|| CliError::MergeNoHeader(p.clone()))?;
+        if meta.spp == 0 {
+            return Err(CliError::MergeEmptyPart(p.clone()));
+        }
         if let Some((p0, i0, m0)) = loaded.first() {
             if m0.scene_hash != meta.scene_hash {
                 return Err(CliError::MergeScenes {
@@ -116,7 +119,7 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<(u32, u64), CliError> {
     let total: u64 = loaded.iter().map(|(_, _, m)| m.spp as u64).sum();
     let total_u32 = u32::try_from(total).map_err(|_| CliError::MergeTooLarge(total))?;
     let (w, h) = (loaded[0].1.width, loaded[0].1.height);
-    let mut sums = vec![[0.0f64; 3]; (w * h) as usize];
+    let mut sums = vec![[0.0f64; 3]; w as usize * h as usize];
     for (_, img, m) in &loaded {
         let k = m.spp as f64;
         for (s, p) in sums.iter_mut().zip(&img.pixels) {

@@ -47,12 +47,13 @@ pub(super) fn info(a: InfoArgs) -> Result<(), CliError> {
             .texture_of(i as u32)
             .map_or(String::new(), |t| format!(", texture: {t}"));
         println!(
-            "  \"{}\": {:?}, {m}{texture}",
-            rs.prims.names[i], rs.prims.kind[i]
+            "  {}: {:?}, {m}{texture}",
+            crate::components::quoted(&rs.prims.names[i]),
+            rs.prims.kind[i]
         );
     }
     for (_, name, light) in points {
-        println!("  \"{name}\": light: {light}");
+        println!("  {}: light: {light}", crate::components::quoted(&name));
     }
     if scene.environment != glam::Vec3::ZERO {
         println!(

@@ -22,6 +22,28 @@ use glam::Affine3A;
 #[derive(Clone, Debug, PartialEq, Eq)]
 pub struct Name(pub String);
 
+/// The longest name a message shows in full, in characters.
+pub const SHOWN_NAME_CHARS: usize = 64;
+
+/// `name` in double quotes as messages and `prism info` print it: control characters,
+/// quotes and backslashes escaped (a name cannot move the cursor or recolour a terminal), and
+/// cut after [`SHOWN_NAME_CHARS`] characters with the full length given.
+pub fn quoted(name: &str) -> String {
+    let mut out = String::with_capacity(name.len().min(4 * SHOWN_NAME_CHARS) + 2);
+    out.push('"');
+    out.extend(
+        name.chars()
+            .take(SHOWN_NAME_CHARS)
+            .flat_map(char::escape_debug),
+    );
+    out.push('"');
+    let n = name.chars().count();
+    if n > SHOWN_NAME_CHARS {
+        out.push_str(&format!("… ({n} characters)"));
+    }
+    out
+}
+
 /// Object-to-world placement: scale, then rotation R = Rz·Ry·Rx (degrees), then translation.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Transform {

@@ -75,13 +75,15 @@ impl RenderScene {
                 && emission.max_element() <= 0.0
             {
                 out.push(format!(
-                    "entity \"{name}\": a Light with zero emission emits nothing"
+                    "entity {}: a Light with zero emission emits nothing",
+                    crate::components::quoted(name)
                 ));
             }
             if self.lamp_faces_nothing(i) {
                 out.push(format!(
-                    "entity \"{name}\": a one-sided Light whose front faces no other entity \
-                     and not the camera lights nothing (turn it, or set two_sided: true)"
+                    "entity {}: a one-sided Light whose front faces no other entity \
+                     and not the camera lights nothing (turn it, or set two_sided: true)",
+                    crate::components::quoted(name)
                 ));
             }
             let opaque = !matches!(
@@ -91,8 +93,9 @@ impl RenderScene {
             );
             if opaque && self.prims.contains(i as u32, self.camera.origin).is_some() {
                 out.push(format!(
-                    "the camera is inside entity \"{name}\", a closed opaque shape: it sees only \
-                     its inside"
+                    "the camera is inside entity {}, a closed opaque shape: it sees only \
+                     its inside",
+                    crate::components::quoted(name)
                 ));
             }
         }

@@ -64,7 +64,7 @@ impl fmt::Display for SceneError {
             } => {
                 write!(f, "{}:{}:{}: ", path.display(), line, col)?;
                 if let Some(e) = entity {
-                    write!(f, "entity \"{e}\": ")?;
+                    write!(f, "entity {}: ", crate::components::quoted(e))?;
                 }
                 if let Some(fi) = field {
                     write!(f, "field `{fi}`: ")?;
@@ -78,9 +78,9 @@ impl fmt::Display for SceneError {
                 message,
             } => write!(
                 f,
-                "{}: entity \"{}\": field `{}`: {}",
+                "{}: entity {}: field `{}`: {}",
                 path.display(),
-                entity,
+                crate::components::quoted(entity),
                 field,
                 message
             ),

@@ -120,6 +120,19 @@ pub fn load_str(
             hash = fnv1a(v.as_bytes(), hash);
         }
     }
+    // The file's own size was checked as it was read; an override may have grown it.
+    if let Some((k, _)) = overrides
+        .iter()
+        .rev()
+        .find(|(k, _)| k == "render.width" || k == "render.height")
+    {
+        schema::check_film_size(scene.render.width.0, scene.render.height.0).map_err(
+            |message| SceneError::Override {
+                key: k.clone(),
+                message,
+            },
+        )?;
+    }
     build_world(scene, path, hash)
 }
 
@@ -129,8 +142,16 @@ pub fn parse(text: &str, path: &Path) -> Result<schema::Scene, SceneError> {
     ron_options().from_str::<schema::Scene>(text).map_err(|e| {
         let pos = e.span.start;
         let at = offset_of(text, pos.line, pos.col);
-        let (entity, field) = context_at(text, at);
+        let (entity, mut field) = context_at(text, at);
         let mut message = e.code.to_string();
+        // A check of several fields together is raised where the group ends, after its last
+        // field: such messages name their own field as "field `NAME`: ...".
+        if let Some(rest) = message.strip_prefix("field `")
+            && let Some((name, why)) = rest.split_once("`: ")
+        {
+            field = Some(name.to_string());
+            message = why.to_string();
+        }
         // A bare tuple where an enum is expected (`albedo: (0.8, 0.3, 0.2)`): RON's own words
         // do not say what is missing.
         if matches!(e.code, ron::Error::ExpectedIdentifier) && text[at..].starts_with('(') {

@@ -27,7 +27,7 @@ pub fn detect_effects(
         .query::<(&Name, &Motion)>()
         .iter()
         .filter(|(_, m)| !m.is_static())
-        .map(|(n, _)| format!("\"{}\"", n.0))
+        .map(|(n, _)| crate::components::quoted(&n.0))
         .collect();
     let camera_moves = path.is_some_and(|p| p.moves_within(shutter.0, shutter.1));
     let shutter_open = shutter.1 > shutter.0;
@@ -76,12 +76,22 @@ pub fn detect_effects(
         .query::<(hecs::Entity, &Name, &Material)>()
         .iter()
         .filter_map(|(e, n, m)| match m {
-            Material::Dielectric { ior } if ior.is_dispersive() => {
-                Some((e, format!("entity \"{}\": {}", n.0, describe_ior(ior))))
-            }
-            Material::Light { spectrum, .. } if spectrum.is_spectral() => {
-                Some((e, format!("entity \"{}\": {}", n.0, spectrum.describe())))
-            }
+            Material::Dielectric { ior } if ior.is_dispersive() => Some((
+                e,
+                format!(
+                    "entity {}: {}",
+                    crate::components::quoted(&n.0),
+                    describe_ior(ior)
+                ),
+            )),
+            Material::Light { spectrum, .. } if spectrum.is_spectral() => Some((
+                e,
+                format!(
+                    "entity {}: {}",
+                    crate::components::quoted(&n.0),
+                    spectrum.describe()
+                ),
+            )),
             _ => None,
         })
         .collect();
@@ -90,7 +100,16 @@ pub fn detect_effects(
             .query::<(hecs::Entity, &Name, &crate::components::PointLight)>()
             .iter()
             .filter(|(_, _, l)| l.spectrum.is_spectral())
-            .map(|(e, n, l)| (e, format!("entity \"{}\": {}", n.0, l.spectrum.describe()))),
+            .map(|(e, n, l)| {
+                (
+                    e,
+                    format!(
+                        "entity {}: {}",
+                        crate::components::quoted(&n.0),
+                        l.spectrum.describe()
+                    ),
+                )
+            }),
     );
     // Entities in file order, so the reason names the first one the user wrote.
     emitters.sort_by_key(|(e, _)| e.id());
@@ -112,7 +131,7 @@ pub fn detect_effects(
             .query::<(&Name, &Texture)>()
             .iter()
             .filter(|(_, t)| f(t))
-            .map(|(n, _)| format!("\"{}\"", n.0))
+            .map(|(n, _)| crate::components::quoted(&n.0))
             .collect()
     };
     let list = |v: &[String]| {
@@ -145,7 +164,7 @@ pub fn detect_effects(
     let media: Vec<String> = world
         .query::<(&Name, &crate::components::Medium)>()
         .iter()
-        .map(|(n, _)| format!("\"{}\"", n.0))
+        .map(|(n, _)| crate::components::quoted(&n.0))
         .collect();
     if media.is_empty() {
         fx.set(Effect::Media, false, "no Medium component");

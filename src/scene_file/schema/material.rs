@@ -213,7 +213,9 @@ impl TryFrom<EmissionSpec> for Emission {
             if scale.is_finite() && scale >= 0.0 {
                 Ok(())
             } else {
-                Err(format!("scale must be a finite number >= 0, got {scale}"))
+                Err(format!(
+                    "field `scale`: must be a finite number >= 0, got {scale}"
+                ))
             }
         };
         let spectrum = match s {
@@ -232,7 +234,7 @@ impl TryFrom<EmissionSpec> for Emission {
             EmissionSpec::Blackbody { kelvin, scale } => {
                 if !(kelvin.is_finite() && (500.0..=1.0e5).contains(&kelvin)) {
                     return Err(format!(
-                        "kelvin must be in 500..=100000 (a body colder than 500 K emits almost \
+                        "field `kelvin`: must be in 500..=100000 (a body colder than 500 K emits almost \
                          nothing visible), got {kelvin}"
                     ));
                 }

@@ -32,13 +32,13 @@ impl TryFrom<MediumRaw> for MediumSpec {
             let v = c.vec();
             if !(v.is_finite() && v.min_element() >= 0.0) {
                 return Err(format!(
-                    "{name} must be finite and >= 0 in every channel, got Rgb({}, {}, {})",
+                    "field `{name}`: must be finite and >= 0 in every channel, got Rgb({}, {}, {})",
                     v.x, v.y, v.z
                 ));
             }
         }
         if !(m.g.is_finite() && m.g > -1.0 && m.g < 1.0) {
-            return Err(format!("g must be in (-1, 1), got {}", m.g));
+            return Err(format!("field `g`: must be in (-1, 1), got {}", m.g));
         }
         Ok(MediumSpec {
             sigma_a: m.sigma_a,

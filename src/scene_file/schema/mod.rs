@@ -33,7 +33,7 @@ use serde::Deserialize;
 #[serde(deny_unknown_fields)]
 pub struct Scene {
     /// Image and integrator settings; every one has a default.
-    #[serde(default)]
+    #[serde(default, deserialize_with = "render::checked_render")]
     pub render: Render,
     /// The camera; an `animation`'s keyframes override its placement, not its lens or shutter.
     pub camera: Camera,

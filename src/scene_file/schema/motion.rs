@@ -65,7 +65,7 @@ impl TryFrom<AnimationSpec> for Animation {
     type Error = String;
     fn try_from(a: AnimationSpec) -> Result<Self, String> {
         if !(1..=1000).contains(&a.fps) {
-            return Err(format!("fps must be in 1..=1000, got {}", a.fps));
+            return Err(format!("field `fps`: must be in 1..=1000, got {}", a.fps));
         }
         if a.keyframes.is_empty() {
             return Err("an animation needs at least one keyframe".into());

@@ -38,6 +38,30 @@ pub struct Render {
     pub newton_tolerance: Option<Positive>,
 }
 
+/// The most pixels a film may have: 2²⁸ (16384 × 16384), the bound on decoded images too.
+/// The film keeps about 24 bytes per pixel, so this is 6 GiB; each side is at most 65536.
+pub const MAX_PIXELS: u64 = 1 << 28;
+
+/// Refuses a film above [`MAX_PIXELS`], before anything is allocated.
+pub fn check_film_size(width: u32, height: u32) -> Result<(), String> {
+    let n = u64::from(width) * u64::from(height);
+    if n <= MAX_PIXELS {
+        Ok(())
+    } else {
+        Err(format!(
+            "width × height = {width} × {height} = {n} pixels, above the limit of {MAX_PIXELS} \
+             (16384 × 16384)"
+        ))
+    }
+}
+
+/// `render:` read and its film size checked, so a file's error carries its position.
+pub(super) fn checked_render<'de, D: serde::Deserializer<'de>>(d: D) -> Result<Render, D::Error> {
+    let r = Render::deserialize(d)?;
+    check_film_size(r.width.0, r.height.0).map_err(serde::de::Error::custom)?;
+    Ok(r)
+}
+
 fn default_width() -> ImageDim {
     ImageDim(640)
 }

@@ -108,7 +108,7 @@ impl TryFrom<ShapeSpec> for Shape {
                 radius,
             } => {
                 if normal.vec().length_squared() <= 0.0 {
-                    return Err("Disk: normal must be a non-zero vector".into());
+                    return Err("field `normal`: a Disk's normal must be a non-zero vector".into());
                 }
                 Shape::Disk {
                     center,
