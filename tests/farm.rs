@@ -232,6 +232,16 @@ fn merge_refuses_parts_that_do_not_belong_together() {
             || merge("a.exr", "small.exr").contains("32x24")
     );
     assert!(merge("a.exr", "a.png").contains("header"));
+    // A part that claims no samples averaged to an all-NaN image.
+    let (img, meta) = prism::film::read_image(&p("a.exr")).unwrap();
+    let mut meta = meta.unwrap();
+    (meta.spp, meta.sample_offset) = (0, 4);
+    prism::film::write_image(&p("empty.exr"), &img, &meta, &Default::default()).unwrap();
+    let err = merge("a.exr", "empty.exr");
+    assert!(
+        err.contains("empty.exr") && err.contains("no samples"),
+        "{err}"
+    );
     assert!(!p("m.exr").exists());
 }
 
@@ -302,4 +312,101 @@ fn a_width_the_cpu_lacks_or_does_not_know_is_refused_in_one_line() {
     );
     assert!(run(&["--set", "render.simd=auto"]).status.success());
     assert!(run(&["--set", "render.simd=1"]).status.success());
+}
+
+/// The ```yaml block of docs/farm.md.
+fn kubernetes_job() -> String {
+    let text = std::fs::read_to_string(Path::new(env!("CARGO_MANIFEST_DIR")).join("docs/farm.md"))
+        .unwrap();
+    let start = text
+        .find("```yaml\n")
+        .expect("docs/farm.md has a yaml block")
+        + 8;
+    let end = text[start..].find("```").unwrap();
+    text[start..start + end].to_string()
+}
+
+#[test]
+fn the_kubernetes_job_is_valid_yaml_whose_shards_cover_the_frames() {
+    use yaml_rust2::YamlLoader;
+    let docs = YamlLoader::load_from_str(&kubernetes_job()).expect("docs/farm.md's Job parses");
+    assert_eq!(docs.len(), 1);
+    let job = &docs[0];
+    assert_eq!(job["apiVersion"].as_str(), Some("batch/v1"));
+    assert_eq!(job["kind"].as_str(), Some("Job"));
+    assert!(job["metadata"]["name"].as_str().is_some());
+    let spec = &job["spec"];
+    // JOB_COMPLETION_INDEX exists only in Indexed mode; it runs 0 .. completions - 1.
+    assert_eq!(spec["completionMode"].as_str(), Some("Indexed"));
+    let completions = spec["completions"].as_i64().expect("completions");
+    assert!((1..=completions).contains(&spec["parallelism"].as_i64().expect("parallelism")));
+    let pod = &spec["template"]["spec"];
+    // Indexed Jobs allow only these two.
+    assert!(
+        matches!(pod["restartPolicy"].as_str(), Some("OnFailure" | "Never")),
+        "{:?}",
+        pod["restartPolicy"]
+    );
+    let container = &pod["containers"][0];
+    let command: Vec<String> = container["command"]
+        .as_vec()
+        .expect("command is a list")
+        .iter()
+        .map(|v| v.as_str().expect("command words are strings").to_string())
+        .collect();
+    let after = |flag: &str| {
+        let i = command
+            .iter()
+            .position(|w| w == flag)
+            .unwrap_or_else(|| panic!("{flag}"));
+        command[i + 1].clone()
+    };
+    assert_eq!(command[..2], ["prism", "render"]);
+    assert_eq!(after("--shard-from-env"), "JOB_COMPLETION_INDEX");
+    assert_eq!(after("--shard-count"), completions.to_string());
+    assert!(command.iter().any(|w| w == "--resume"));
+    // Frames go to a mounted volume that the pod declares.
+    let output = after("-o");
+    let mounts = container["volumeMounts"].as_vec().expect("volumeMounts");
+    let mount = mounts
+        .iter()
+        .find(|m| output.starts_with(m["mountPath"].as_str().unwrap_or("\0")))
+        .expect("the output lies on a mounted volume");
+    let volumes = pod["volumes"].as_vec().expect("volumes");
+    assert!(volumes.iter().any(|v| v["name"] == mount["name"]));
+
+    // The same words run here: shard 0 of a small stand-in scene writes frames f ≡ 0 (mod N).
+    let (d, scene) = setup();
+    let out = d.path().join("out");
+    let frames = after("--frames");
+    let args: Vec<String> = command[1..]
+        .iter()
+        .map(|w| {
+            if w.ends_with(".ron") {
+                scene.to_str().unwrap().to_string()
+            } else if w == &output {
+                out.join(Path::new(w).file_name().unwrap())
+                    .to_str()
+                    .unwrap()
+                    .to_string()
+            } else if w == &frames {
+                // The stand-in is ten frames long.
+                "0..10".to_string()
+            } else {
+                w.clone()
+            }
+        })
+        .collect();
+    ok(prism().args(&args).env("JOB_COMPLETION_INDEX", "0"));
+    let mut written: Vec<String> = std::fs::read_dir(&out)
+        .unwrap()
+        .map(|e| e.unwrap().file_name().into_string().unwrap())
+        .collect();
+    written.sort();
+    let n = completions as usize;
+    let want: Vec<String> = (0..10)
+        .step_by(n)
+        .map(|f| format!("flyby_{f:04}.png"))
+        .collect();
+    assert_eq!(written, want);
 }
