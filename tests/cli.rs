@@ -332,6 +332,63 @@ fn checks_of_several_fields_name_the_field_at_fault() {
 }
 
 #[test]
+fn asset_paths_stay_inside_the_asset_root_unless_allowed() {
+    let d = tempfile::tempdir().unwrap();
+    let scenes = d.path().join("project/scenes");
+    std::fs::create_dir_all(&scenes).unwrap();
+    // Any readable file would do: the path is refused before anything reads it.
+    let secret = d.path().join("secret.png");
+    std::fs::write(&secret, b"not an image").unwrap();
+    let textured = |path: &str| {
+        GOOD.replace(
+            "material: Diffuse(albedo: Rgb(0.5, 0.5, 0.5))",
+            &format!(
+                "material: Diffuse(albedo: Rgb(0.5, 0.5, 0.5)), texture: (albedo: Image(path: {path:?}))"
+            ),
+        )
+    };
+    let climbs = write(&scenes, "climbs.ron", &textured("../../secret.png"));
+    let err = fails(&["render", climbs.to_str().unwrap()]);
+    assert!(
+        err.contains("climbs.ron")
+            && err.contains("entity \"ball\"")
+            && err.contains("outside the asset root"),
+        "{err}"
+    );
+    let absolute = write(&scenes, "abs.ron", &textured(secret.to_str().unwrap()));
+    let err = fails(&["render", absolute.to_str().unwrap()]);
+    assert!(err.contains("absolute asset path"), "{err}");
+    // Lifted, or moved to include the file, the check passes and the image is read (and
+    // refused as an image, which shows the path got through).
+    for extra in [
+        vec!["--allow-any-path".to_string()],
+        vec![
+            "--asset-root".to_string(),
+            d.path().to_str().unwrap().to_string(),
+        ],
+    ] {
+        let mut args = vec!["render".to_string(), climbs.to_str().unwrap().to_string()];
+        args.extend(extra);
+        let args: Vec<&str> = args.iter().map(String::as_str).collect();
+        let err = fails(&args);
+        assert!(
+            !err.contains("asset root") && err.contains("secret.png"),
+            "{err}"
+        );
+    }
+    let err = fails(&[
+        "render",
+        climbs.to_str().unwrap(),
+        "--asset-root",
+        "/nonexistent/dir",
+    ]);
+    assert!(
+        err.contains("--asset-root") && err.contains("not a folder"),
+        "{err}"
+    );
+}
+
+#[test]
 fn negative_exposure_is_a_value_and_a_non_finite_one_is_refused() {
     let d = tempfile::tempdir().unwrap();
     let good = write(d.path(), "g.ron", GOOD);

@@ -339,6 +339,9 @@ fn tutorial_scenes_load_and_render() {
             .arg("render")
             .arg(scene)
             .args(["--spp", "1", "--quiet", "--set", "render.width=32"])
+            // As the tutorial's commands: its mesh lies outside docs/, the default root.
+            .arg("--asset-root")
+            .arg(root())
             .args(["--set", "render.height=24", "-o"])
             .arg(&png)
             .output()

@@ -16,6 +16,13 @@ pub struct Cli {
     /// The command to run.
     #[command(subcommand)]
     pub(super) command: Command,
+    /// Mesh and image paths must resolve inside DIR (default: the parent of the scene's
+    /// folder); absolute paths are refused.
+    #[arg(long, global = true, value_name = "DIR")]
+    pub(super) asset_root: Option<PathBuf>,
+    /// Let scenes name mesh and image files anywhere, absolute paths included.
+    #[arg(long, global = true, conflicts_with = "asset_root")]
+    pub(super) allow_any_path: bool,
 }
 
 /// A command with its options.

@@ -203,6 +203,9 @@ pub enum CliError {
     /// The merged sample count does not fit the image header's u32.
     #[error("merged sample count {0} is too large")]
     MergeTooLarge(u64),
+    /// `--asset-root` is not a folder.
+    #[error("--asset-root '{}' is not a folder", .0.display())]
+    AssetRoot(PathBuf),
     /// A part holds no samples: its pixels are not an estimate of anything.
     #[error("'{}' holds no samples (prism:spp = 0): leave it out of the merge", .0.display())]
     MergeEmptyPart(PathBuf),

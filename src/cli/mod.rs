@@ -19,6 +19,15 @@ pub use error::CliError;
 
 /// Runs a parsed command line.
 pub fn run(cli: Cli) -> Result<(), CliError> {
+    use crate::scene_file::assets::{AssetPolicy, set_policy};
+    if cli.allow_any_path {
+        set_policy(AssetPolicy::Any);
+    } else if let Some(root) = cli.asset_root {
+        if !root.is_dir() {
+            return Err(CliError::AssetRoot(root));
+        }
+        set_policy(AssetPolicy::Root(root));
+    }
     match cli.command {
         Command::Render(a) => render::render(a),
         Command::Info(a) => info::info(a),

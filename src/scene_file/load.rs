@@ -1,5 +1,6 @@
 //! Scene file → ECS world: parse, apply `--set` overrides, spawn one entity per object.
 
+use super::assets::AssetPolicy;
 use super::error::{SceneError, context_at, offset_of};
 use super::{patch, schema};
 use crate::components::camera::{CameraKey, CameraPath};
@@ -60,8 +61,18 @@ pub struct LoadedScene {
     pub hash: u64,
 }
 
-/// Reads and parses a scene file, with `--set` overrides applied.
+/// Reads and parses a scene file, with `--set` overrides applied; its mesh and image paths
+/// must satisfy [`AssetPolicy::for_scene`] (inside the scene folder's parent by default).
 pub fn load(path: &Path, overrides: &[(String, String)]) -> Result<LoadedScene, SceneError> {
+    load_with(path, overrides, &AssetPolicy::for_scene(path))
+}
+
+/// [`load`] with an explicit asset policy.
+pub fn load_with(
+    path: &Path,
+    overrides: &[(String, String)],
+    assets: &AssetPolicy,
+) -> Result<LoadedScene, SceneError> {
     let text =
         crate::files::read_text_bounded(path, crate::files::MAX_SCENE_BYTES).map_err(|source| {
             SceneError::Io {
@@ -69,14 +80,24 @@ pub fn load(path: &Path, overrides: &[(String, String)]) -> Result<LoadedScene, 
                 source,
             }
         })?;
-    load_str(&text, path, overrides)
+    load_text(&text, path, overrides, assets)
 }
 
-/// Parses scene text; `path` is used in messages and to resolve relative asset paths.
+/// Parses scene text; `path` is used in messages and to resolve relative asset paths, which
+/// may lie anywhere (the caller chose the text; [`load`] applies the asset root to files).
 pub fn load_str(
     text: &str,
     path: &Path,
     overrides: &[(String, String)],
+) -> Result<LoadedScene, SceneError> {
+    load_text(text, path, overrides, &AssetPolicy::Any)
+}
+
+fn load_text(
+    text: &str,
+    path: &Path,
+    overrides: &[(String, String)],
+    assets: &AssetPolicy,
 ) -> Result<LoadedScene, SceneError> {
     let mut hash = fnv1a(text.as_bytes(), FNV_OFFSET);
     // Entity paths edit the text, so their values are read and checked as the file's own.
@@ -133,7 +154,7 @@ pub fn load_str(
             },
         )?;
     }
-    build_world(scene, path, hash)
+    build_world(scene, path, hash, assets)
 }
 
 /// Deserialises the schema, turning RON's error position into file:line:col with the entity
@@ -295,7 +316,12 @@ fn transform_of(t: &Option<schema::Transform>) -> Transform {
     }
 }
 
-fn build_world(scene: schema::Scene, path: &Path, hash: u64) -> Result<LoadedScene, SceneError> {
+fn build_world(
+    scene: schema::Scene,
+    path: &Path,
+    hash: u64,
+    assets: &AssetPolicy,
+) -> Result<LoadedScene, SceneError> {
     let cam = &scene.camera;
     let (pos, at, up) = (cam.position.vec(), cam.look_at.vec(), cam.up.vec());
     let fwd = at - pos;
@@ -391,6 +417,22 @@ fn build_world(scene: schema::Scene, path: &Path, hash: u64) -> Result<LoadedSce
             message,
         };
         let transform = transform_of(&e.transform);
+        // Files are checked against the asset root before anything reads them.
+        if let Some(schema::Shape::Mesh { path: p }) = &e.shape {
+            assets.check(scene_dir, p).map_err(|m| err("shape", m))?;
+        }
+        if let Some(t) = &e.texture {
+            if let Some(schema::AlbedoSpec::Image { path: p, .. }) = &t.albedo {
+                assets
+                    .check(scene_dir, &p.0)
+                    .map_err(|m| err("texture", m))?;
+            }
+            if let Some(schema::NormalMapSpec::Image { path: p, .. }) = &t.normal_map {
+                assets
+                    .check(scene_dir, &p.0)
+                    .map_err(|m| err("texture", m))?;
+            }
+        }
         if let Some(l) = &e.light {
             if e.shape.is_some() || e.material.is_some() {
                 return Err(err(
