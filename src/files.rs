@@ -42,6 +42,25 @@ pub fn read_bounded(path: &Path, max: u64) -> io::Result<Vec<u8>> {
     Ok(bytes)
 }
 
+/// At most the first `max` bytes of the regular file at `path` (symbolic links followed): what
+/// a header reader needs.
+pub fn read_prefix(path: &Path, max: u64) -> io::Result<Vec<u8>> {
+    let meta = std::fs::metadata(path)?;
+    if meta.is_dir() {
+        return Err(refused("it is a directory".into()));
+    }
+    if !meta.is_file() {
+        return Err(refused(
+            "it is not a regular file (a FIFO, socket or device)".into(),
+        ));
+    }
+    let mut bytes = Vec::with_capacity(meta.len().min(max) as usize);
+    std::fs::File::open(path)?
+        .take(max)
+        .read_to_end(&mut bytes)?;
+    Ok(bytes)
+}
+
 /// [`read_bounded`] as UTF-8 text.
 pub fn read_text_bounded(path: &Path, max: u64) -> io::Result<String> {
     String::from_utf8(read_bounded(path, max)?).map_err(|_| {

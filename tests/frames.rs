@@ -108,6 +108,11 @@ fn killed_series_resumes_to_the_same_files() {
             .filter(|f| !f.file_name().unwrap().to_string_lossy().starts_with('.'))
             .collect()
     };
+    // The killed process's temporary file, if it was writing, was swept by the resumed run.
+    for f in files(&resumed) {
+        let name = f.file_name().unwrap().to_string_lossy().into_owned();
+        assert!(!name.starts_with('.'), "temporary file left: {name}");
+    }
     let (a, b) = (pngs(&whole), pngs(&resumed));
     assert_eq!(a.len(), b.len());
     for (x, y) in a.iter().zip(&b) {

@@ -178,13 +178,91 @@ fn the_readme_slurm_jobs_run_on_a_real_cluster() {
     }
     // No temporary file of any write is left behind.
     for sub in [dir.to_path_buf(), dir.join("out")] {
-        for e in std::fs::read_dir(&sub).unwrap() {
-            let n = e.unwrap().file_name().into_string().unwrap();
-            assert!(!n.contains(".tmp-"), "stray temporary file {n}");
-        }
+        assert_no_temporaries(&sub);
     }
+    let t1 = t0.elapsed().as_secs_f64();
+    cancelled_task_resumes(&dir.join("cancel"));
     println!(
-        "slurm: frames and batches jobs done in {:.1} s",
-        t0.elapsed().as_secs_f64()
+        "slurm: frames and batches jobs done in {t1:.1} s; cancel and resume in {:.1} s",
+        t0.elapsed().as_secs_f64() - t1
     );
+}
+
+fn assert_no_temporaries(dir: &Path) {
+    for e in std::fs::read_dir(dir).unwrap() {
+        let n = e.unwrap().file_name().into_string().unwrap();
+        assert!(!n.starts_with('.'), "stray temporary file {n} in {dir:?}");
+    }
+}
+
+/// The README's frame job with slower frames: array task 1 is cancelled (`scancel`, which
+/// sends SIGTERM) after its first frame, then the job is submitted again, as is, and its
+/// `--resume` finishes the series: every frame of the cancelled shard equals a single-machine
+/// render of that shard, and no temporary file is left.
+fn cancelled_task_resumes(dir: &Path) {
+    std::fs::create_dir_all(dir.join("scenes")).unwrap();
+    std::fs::write(
+        dir.join("scenes/flyby.ron"),
+        FLYBY.replace("spp: 4,", "spp: 2048,"),
+    )
+    .unwrap();
+    std::fs::write(dir.join("frames.sh"), readme_script("frames.sh")).unwrap();
+    let job = run(in_dir(dir, "sbatch").args(["--parsable", "-o", "cancel-%a.log", "frames.sh"]));
+    let job = job.trim().split(';').next().unwrap().to_string();
+    // Shard 1 renders frames 1, 5, 9, …: cancel it once its first frame is on disk.
+    let start = Instant::now();
+    while !dir.join("out/flyby_0001.png").exists() {
+        assert!(
+            start.elapsed() < Duration::from_secs(300),
+            "task 1 never wrote its first frame"
+        );
+        std::thread::sleep(Duration::from_millis(10));
+    }
+    run(in_dir(dir, "scancel").arg(format!("{job}_1")));
+    wait_for_jobs(dir, Duration::from_secs(600));
+    let shard1: Vec<String> = (1..48)
+        .step_by(4)
+        .map(|f| format!("flyby_{f:04}.png"))
+        .collect();
+    let done = shard1
+        .iter()
+        .filter(|n| dir.join("out").join(n).exists())
+        .count();
+    assert!(
+        done < shard1.len(),
+        "task 1 finished before the cancel reached it"
+    );
+    let log = std::fs::read_to_string(dir.join("cancel-1.log")).unwrap_or_default();
+    assert!(
+        log.contains("interrupted by SIGTERM") || log.contains("CANCELLED"),
+        "task 1's log: {log}"
+    );
+    // Submitted again as is: --resume renders what is missing.
+    run(in_dir(dir, "timeout").args([
+        "600",
+        "sbatch",
+        "--wait",
+        "-o",
+        "resume-%a.log",
+        "frames.sh",
+    ]));
+    run(in_dir(dir, "prism").args([
+        "render",
+        "scenes/flyby.ron",
+        "--frames",
+        "0..48",
+        "--shard",
+        "1/4",
+        "-o",
+        "single/flyby_####.png",
+        "--quiet",
+    ]));
+    for n in &shard1 {
+        let a = std::fs::read(dir.join("out").join(n)).unwrap();
+        let b = std::fs::read(dir.join("single").join(n)).unwrap();
+        assert!(a == b, "{n} differs from the single-machine render");
+    }
+    let all = std::fs::read_dir(dir.join("out")).unwrap().count();
+    assert_eq!(all, 48, "every frame once, nothing else");
+    assert_no_temporaries(&dir.join("out"));
 }

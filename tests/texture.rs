@@ -304,6 +304,8 @@ fn float_sources_are_linear_in_either_space() {
         sample_offset: 0,
         scene_hash: 0,
         simd: None,
+        complete: true,
+        settings: None,
     };
     write_image(&exr, &film, &meta, &PngOptions::default()).unwrap();
     let hdr = dir.path().join("t.hdr");

@@ -58,6 +58,23 @@ pub enum CliError {
         .0.display()
     )]
     FrameTemplate(PathBuf),
+    /// SIGINT or SIGTERM stopped the render: a still is written with the samples it has
+    /// (`written`), a frame series drops the frame in flight.
+    #[error("{}", interrupted_message(.name, .written.as_deref(), *.series, *.spp, *.asked))]
+    Interrupted {
+        /// The signal's number (the exit status is 128 + it).
+        signal: i32,
+        /// The signal's name.
+        name: &'static str,
+        /// The still written, marked incomplete, if any samples were done.
+        written: Option<PathBuf>,
+        /// A frame series was stopped.
+        series: bool,
+        /// Samples per pixel in it.
+        spp: u32,
+        /// Samples per pixel asked for.
+        asked: u32,
+    },
     /// The GIF of a frame range could not be encoded.
     #[error("cannot write '{}': {error}", .path.display())]
     Gif {
@@ -212,6 +229,38 @@ pub enum CliError {
 }
 
 /// The names `--force` accepts, comma-separated.
+impl CliError {
+    /// The process exit status for this failure: 128 + the signal's number for a render a
+    /// signal stopped (as a shell reports a process the signal killed), 1 otherwise.
+    pub fn exit_code(&self) -> u8 {
+        match self {
+            CliError::Interrupted { signal, .. } => u8::try_from(128 + signal).unwrap_or(1),
+            _ => 1,
+        }
+    }
+}
+
+fn interrupted_message(
+    name: &str,
+    written: Option<&std::path::Path>,
+    series: bool,
+    spp: u32,
+    asked: u32,
+) -> String {
+    match written {
+        Some(p) => format!(
+            "interrupted by {name}: wrote '{}' with {spp} of {asked} samples per pixel, \
+             marked incomplete (prism:complete = 0)",
+            p.display()
+        ),
+        None if series => format!(
+            "interrupted by {name}: the frames written are complete, the one in flight was \
+             dropped; run again with --resume to finish the series"
+        ),
+        None => format!("interrupted by {name} before any pass finished: nothing written"),
+    }
+}
+
 fn effect_names() -> String {
     Effect::ALL
         .iter()

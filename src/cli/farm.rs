@@ -148,6 +148,8 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<(u32, u64), CliError> {
         sample_offset: ranges[0].0,
         scene_hash: loaded[0].2.scene_hash,
         simd: loaded[0].2.simd,
+        complete: loaded.iter().all(|(_, _, m)| m.complete),
+        settings: loaded[0].2.settings,
     };
     film::write_image(out, &merged, &meta, &PngOptions::default())?;
     Ok((total_u32, ranges[0].0))

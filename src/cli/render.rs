@@ -39,6 +39,8 @@ pub(super) fn render(a: RenderArgs) -> Result<(), CliError> {
         return Err(CliError::Threads(t));
     }
     let scene = load_scene(&a.scene, &a.set, &extra)?;
+    // From here on, SIGINT and SIGTERM stop the render and keep what it has.
+    film::signals::install();
     let stem = a
         .scene
         .file_stem()
@@ -68,7 +70,7 @@ pub(super) fn render(a: RenderArgs) -> Result<(), CliError> {
             eprintln!("warning: {w}");
         }
     }
-    let out = render_to_file(&a, &scene, &rs, &pool, &output, "")?;
+    let out = render_to_file(&a, &scene, &rs, &pool, &output, "", Partial::Write)?;
     if a.stats {
         print_stats(&rs, &out, &output, pool.current_num_threads());
     } else if !a.quiet {
@@ -82,6 +84,44 @@ pub(super) fn render(a: RenderArgs) -> Result<(), CliError> {
     Ok(())
 }
 
+/// What a render stopped by a signal does with the samples it has.
+#[derive(Clone, Copy, PartialEq, Eq)]
+enum Partial {
+    /// A still: written under its final name, marked incomplete, with its true sample count.
+    Write,
+    /// A frame of a series: dropped, so no frame on disk is partial.
+    Drop,
+}
+
+/// The lane width this command renders at.
+fn lanes_for(
+    a: &RenderArgs,
+    rs_simd: crate::simd::SimdChoice,
+) -> Result<crate::simd::Lanes, CliError> {
+    let choice = if a.reference {
+        crate::simd::SimdChoice::W1
+    } else {
+        a.simd.unwrap_or(rs_simd)
+    };
+    Ok(crate::simd::Lanes::resolve(choice)?)
+}
+
+/// Hash of the command-line settings that change an image's pixels without being part of the
+/// scene's hash: the forced effects, and the exposure of a PNG (`prism:settings`).
+fn settings_hash(a: &RenderArgs, output: &Path) -> u64 {
+    let mut force: Vec<String> = a.force.iter().map(|f| f.to_ascii_lowercase()).collect();
+    force.sort();
+    force.dedup();
+    let mut text = format!("force={}", force.join(","));
+    if film::ImageFormat::from_path(output).is_ok_and(|f| f == film::ImageFormat::Png) {
+        text.push_str(&format!(";exposure={:08x}", a.exposure.to_bits()));
+    }
+    // FNV-1a: the same in every build, so files from another build of prism still match.
+    text.bytes().fold(0xcbf2_9ce4_8422_2325, |h, b| {
+        (h ^ u64::from(b)).wrapping_mul(0x0100_0000_01b3)
+    })
+}
+
 /// Renders one frame of a prepared scene and writes it atomically.
 fn render_to_file(
     a: &RenderArgs,
@@ -90,14 +130,10 @@ fn render_to_file(
     pool: &rayon::ThreadPool,
     output: &Path,
     label: &str,
+    partial: Partial,
 ) -> Result<integrator::RenderOutput, CliError> {
     let spp = rs.settings.spp;
-    let choice = if a.reference {
-        crate::simd::SimdChoice::W1
-    } else {
-        a.simd.unwrap_or(rs.settings.simd)
-    };
-    let lanes = crate::simd::Lanes::resolve(choice)?;
+    let lanes = lanes_for(a, rs.settings.simd)?;
     if u64::from(a.sample_offset) + u64::from(spp) > 1 << 32 {
         return Err(CliError::SampleRange {
             offset: a.sample_offset,
@@ -110,16 +146,33 @@ fn render_to_file(
         time_limit: a.time_limit,
         lanes,
         monochromatic: None,
+        stop: Some(film::signals::stop_flag()),
     };
     let total = rs.settings.width as u64 * rs.settings.height as u64 * spp as u64;
     let bar = progress::Progress::new(total, a.quiet, label);
     let out = pool.install(|| integrator::render(rs, &opts, &|n| bar.add(n)));
     bar.finish();
+    let interrupted = |written: Option<PathBuf>| {
+        let (signal, name) = film::signals::received().unwrap_or((2, "a signal"));
+        CliError::Interrupted {
+            signal,
+            name,
+            written,
+            series: partial == Partial::Drop,
+            spp: out.spp,
+            asked: spp,
+        }
+    };
+    if out.interrupted && (partial == Partial::Drop || out.spp == 0) {
+        return Err(interrupted(None));
+    }
     let meta = ImageMeta {
         spp: out.spp,
         sample_offset: a.sample_offset as u64,
         scene_hash: scene.hash,
         simd: Some(out.lanes.width() as u32),
+        complete: !out.interrupted,
+        settings: Some(settings_hash(a, output)),
     };
     film::write_image(
         output,
@@ -129,7 +182,57 @@ fn render_to_file(
             exposure: a.exposure,
         },
     )?;
+    if out.interrupted {
+        return Err(interrupted(Some(output.to_path_buf())));
+    }
     Ok(out)
+}
+
+/// Why the frame at `path` cannot be kept by `--resume` (`None`: it can): it must be a complete
+/// render of this scene, these settings, size, width, sample range and sample count (with a
+/// time limit, any positive count up to the one asked).
+fn resume_mismatch(a: &RenderArgs, scene: &LoadedScene, path: &Path, simd: u32) -> Option<String> {
+    let h = match film::read_header(path) {
+        Ok(h) => h,
+        Err(e) => return Some(format!("its header cannot be read ({e})")),
+    };
+    let Some(m) = h.meta else {
+        return Some("it has no prism provenance (prism:* attributes)".into());
+    };
+    let r = &scene.render;
+    let spp_ok = match a.time_limit {
+        Some(_) => (1..=r.spp).contains(&m.spp),
+        None => m.spp == r.spp,
+    };
+    if !m.complete {
+        Some(format!(
+            "it is incomplete ({} of its samples were rendered)",
+            m.spp
+        ))
+    } else if (h.width, h.height) != (r.width, r.height) {
+        Some(format!(
+            "it is {}x{}, not {}x{}",
+            h.width, h.height, r.width, r.height
+        ))
+    } else if m.scene_hash != scene.hash {
+        Some("it comes from another scene text or other --set/--size/--seed values".into())
+    } else if m.settings != Some(settings_hash(a, path)) {
+        Some("it was rendered with other --force or --exposure settings".into())
+    } else if m.simd != Some(simd) {
+        Some(match m.simd {
+            Some(w) => format!("it was rendered at SIMD width {w}, not {simd}"),
+            None => "its SIMD width is not recorded".into(),
+        })
+    } else if m.sample_offset != u64::from(a.sample_offset) {
+        Some(format!(
+            "its samples start at {}, not {}",
+            m.sample_offset, a.sample_offset
+        ))
+    } else if !spp_ok {
+        Some(format!("it has {} spp, not {}", m.spp, r.spp))
+    } else {
+        None
+    }
 }
 
 /// The frames of `range` (this shard's, with `--shard`) rendered to `template`'s paths, then
@@ -154,18 +257,39 @@ fn render_frames(
     let start = std::time::Instant::now();
     let mut rendered = 0u32;
     let mut written = Vec::with_capacity(n);
+    let simd = lanes_for(a, scene.render.simd)?.width() as u32;
     for (k, f) in list.iter().copied().enumerate() {
+        if let Some((signal, name)) = film::signals::received() {
+            return Err(CliError::Interrupted {
+                signal,
+                name,
+                written: None,
+                series: true,
+                spp: 0,
+                asked: scene.render.spp,
+            });
+        }
         let path = frames::frame_path(template, f);
         written.push(path.clone());
-        if a.resume && path.is_file() {
-            if !a.quiet {
-                eprintln!(
-                    "frame {f} ({}/{n}): {} exists, skipped",
+        if a.resume && path.exists() {
+            match resume_mismatch(a, scene, &path, simd) {
+                None => {
+                    if !a.quiet {
+                        eprintln!(
+                            "frame {f} ({}/{n}): {} exists, skipped",
+                            k + 1,
+                            path.display()
+                        );
+                    }
+                    continue;
+                }
+                // Said even with --quiet: the user asked to keep this file.
+                Some(why) => eprintln!(
+                    "frame {f} ({}/{n}): re-rendering {}: {why}",
                     k + 1,
                     path.display()
-                );
+                ),
             }
-            continue;
         }
         // The scene is prepared once; later frames move the camera and rebuild the kd-tree
         // only if primitives move.
@@ -193,7 +317,15 @@ fn render_frames(
             String::new()
         };
         let label = format!("frame {f} ({}/{n}{eta})", k + 1);
-        let out = render_to_file(a, scene, scene_for_frame, pool, &path, &label)?;
+        let out = render_to_file(
+            a,
+            scene,
+            scene_for_frame,
+            pool,
+            &path,
+            &label,
+            Partial::Drop,
+        )?;
         rendered += 1;
         if a.stats {
             print_stats(scene_for_frame, &out, &path, pool.current_num_threads());

@@ -244,6 +244,8 @@ mod tests {
             sample_offset: 0,
             scene_hash: 0,
             simd: None,
+            complete: true,
+            settings: None,
         };
         let opts = PngOptions::default();
         write_image(&pa, &Image::filled(64, 64, [0.0; 3]), &meta, &opts).unwrap();

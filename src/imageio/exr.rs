@@ -6,9 +6,7 @@ use std::path::Path;
 
 use exr::prelude::{self as ex, ReadChannels, ReadLayers, WritableImage};
 
-use super::{
-    ATTR_SAMPLE_OFFSET, ATTR_SCENE_HASH, ATTR_SIMD, ATTR_SPP, FilmError, Image, ImageMeta,
-};
+use super::{FilmError, Image, ImageMeta};
 
 pub(super) fn encode_exr(path: &Path, img: &Image, meta: &ImageMeta) -> Result<Vec<u8>, FilmError> {
     let width = img.width as usize;
@@ -20,14 +18,7 @@ pub(super) fn encode_exr(path: &Path, img: &Image, meta: &ImageMeta) -> Result<V
     });
 
     let mut attributes = ex::LayerAttributes::default();
-    for (name, value) in [
-        (ATTR_SPP, meta.spp.to_string()),
-        (ATTR_SAMPLE_OFFSET, meta.sample_offset.to_string()),
-        (ATTR_SCENE_HASH, format!("{:#018x}", meta.scene_hash)),
-    ]
-    .into_iter()
-    .chain(meta.simd.map(|w| (ATTR_SIMD, w.to_string())))
-    {
+    for (name, value) in meta.attributes() {
         attributes.other.insert(
             ex::Text::from(name),
             ex::AttributeValue::Text(ex::Text::from(value.as_str())),
@@ -109,6 +100,37 @@ pub(super) fn exr_header_attributes(bytes: &[u8]) -> Option<Vec<ExrAttribute>> {
     Some(attrs)
 }
 
+/// The size and provenance of an EXR file from its header alone (its first part).
+pub(super) fn exr_header(
+    path: &Path,
+    bytes: &[u8],
+) -> Result<(u32, u32, Option<ImageMeta>), FilmError> {
+    let decode = |message: String| FilmError::Decode {
+        path: path.to_path_buf(),
+        message,
+    };
+    let meta = exr::meta::MetaData::read_from_buffered(Cursor::new(bytes), false)
+        .map_err(|e| decode(e.to_string()))?;
+    let h = meta
+        .headers
+        .first()
+        .ok_or_else(|| decode("the file has no parts".to_owned()))?;
+    let (w, hgt) = (h.layer_size.0, h.layer_size.1);
+    let too_big = || decode(format!("its header claims {w}×{hgt} pixels"));
+    let attrs = [&h.own_attributes.other, &h.shared_attributes.other];
+    let text = |name: &str| {
+        attrs.iter().find_map(|map| match map.get(name.as_bytes()) {
+            Some(ex::AttributeValue::Text(t)) => Some(t.to_string()),
+            _ => None,
+        })
+    };
+    Ok((
+        u32::try_from(w).map_err(|_| too_big())?,
+        u32::try_from(hgt).map_err(|_| too_big())?,
+        ImageMeta::from_attributes(text),
+    ))
+}
+
 pub(super) fn decode_exr(
     path: &Path,
     bytes: Vec<u8>,
@@ -182,14 +204,7 @@ pub(super) fn decode_exr(
             _ => None,
         })
     };
-    let meta = (|| {
-        Some(ImageMeta {
-            spp: text(ATTR_SPP)?.trim().parse().ok()?,
-            sample_offset: text(ATTR_SAMPLE_OFFSET)?.trim().parse().ok()?,
-            scene_hash: parse_hash(&text(ATTR_SCENE_HASH)?)?,
-            simd: text(ATTR_SIMD).and_then(|t| t.trim().parse().ok()),
-        })
-    })();
+    let meta = ImageMeta::from_attributes(text);
 
     Ok((
         Image {
@@ -199,16 +214,6 @@ pub(super) fn decode_exr(
         },
         meta,
     ))
-}
-
-/// Hex with optional `0x`, the form `write_image` produces.
-fn parse_hash(s: &str) -> Option<u64> {
-    let s = s.trim();
-    let digits = s
-        .strip_prefix("0x")
-        .or_else(|| s.strip_prefix("0X"))
-        .unwrap_or(s);
-    u64::from_str_radix(digits, 16).ok()
 }
 
 /// Reports the first of R, G, B that the first layer lacks, listing what it

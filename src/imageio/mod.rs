@@ -12,13 +12,14 @@ mod atomic;
 mod error;
 mod exr;
 mod raster;
+pub mod signals;
 mod srgb;
 #[cfg(test)]
 mod tests;
 
 use std::path::Path;
 
-pub use atomic::write_atomic;
+pub use atomic::{STALE_AFTER, sweep, write_atomic};
 pub use error::FilmError;
 pub(crate) use error::io_reason;
 pub use raster::{ColorSpace, PngOptions, decode_raster};
@@ -106,6 +107,14 @@ pub struct ImageMeta {
     /// The lane width the samples were computed at (`prism:simd`): widths round differently,
     /// so parts of one image must agree on it. `None` when unknown.
     pub simd: Option<u32>,
+    /// Whether the render finished as asked (`prism:complete`, 1 or 0): every sample, or as
+    /// many as its time limit allowed. A render stopped by a signal writes what it has with
+    /// its true `spp` and 0 here. Files without the attribute count as complete.
+    pub complete: bool,
+    /// Hash of the command-line settings that change pixels but are not part of the scene
+    /// (`prism:settings`: forced effects, PNG exposure), so `--resume` can tell a frame
+    /// rendered otherwise. `None` when unknown.
+    pub settings: Option<u64>,
 }
 
 /// Header attribute names for [`ImageMeta`].
@@ -121,11 +130,60 @@ pub const ATTR_SAMPLE_OFFSET: &str = "prism:sample_offset";
 pub const ATTR_SCENE_HASH: &str = "prism:scene_hash";
 /// The lane width, in decimal (optional: images from before it existed lack it).
 pub const ATTR_SIMD: &str = "prism:simd";
+/// `1` for a finished render, `0` for one stopped by a signal (optional; absent means 1).
+pub const ATTR_COMPLETE: &str = "prism:complete";
+/// [`ImageMeta::settings`] as `0x` and 16 hex digits (optional).
+pub const ATTR_SETTINGS: &str = "prism:settings";
+
+impl ImageMeta {
+    /// The header attributes of `self`, in the order they are written: names and text values,
+    /// the same in EXR headers and PNG text chunks.
+    pub fn attributes(&self) -> Vec<(&'static str, String)> {
+        let mut v = vec![
+            (ATTR_SPP, self.spp.to_string()),
+            (ATTR_SAMPLE_OFFSET, self.sample_offset.to_string()),
+            (ATTR_SCENE_HASH, format!("{:#018x}", self.scene_hash)),
+            (ATTR_COMPLETE, u8::from(self.complete).to_string()),
+        ];
+        if let Some(w) = self.simd {
+            v.push((ATTR_SIMD, w.to_string()));
+        }
+        if let Some(h) = self.settings {
+            v.push((ATTR_SETTINGS, format!("{h:#018x}")));
+        }
+        v
+    }
+
+    /// Metadata from header attributes looked up by `text`: `None` unless `prism:spp`,
+    /// `prism:sample_offset` and `prism:scene_hash` are present and parse.
+    pub fn from_attributes(text: impl Fn(&str) -> Option<String>) -> Option<ImageMeta> {
+        let hash = |t: String| parse_hash(&t);
+        Some(ImageMeta {
+            spp: text(ATTR_SPP)?.trim().parse().ok()?,
+            sample_offset: text(ATTR_SAMPLE_OFFSET)?.trim().parse().ok()?,
+            scene_hash: hash(text(ATTR_SCENE_HASH)?)?,
+            simd: text(ATTR_SIMD).and_then(|t| t.trim().parse().ok()),
+            complete: text(ATTR_COMPLETE).is_none_or(|t| t.trim() != "0"),
+            settings: text(ATTR_SETTINGS).and_then(hash),
+        })
+    }
+}
+
+/// A hash written as hex digits, with or without `0x`.
+fn parse_hash(s: &str) -> Option<u64> {
+    let s = s.trim();
+    let digits = s
+        .strip_prefix("0x")
+        .or_else(|| s.strip_prefix("0X"))
+        .unwrap_or(s);
+    u64::from_str_radix(digits, 16).ok()
+}
 
 /// Output formats [`write_image`] can produce.
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
 pub enum ImageFormat {
-    /// 8-bit sRGB preview, clamped after [`PngOptions::exposure`]; no metadata.
+    /// 8-bit sRGB preview, clamped after [`PngOptions::exposure`]; [`ImageMeta`] as text
+    /// chunks.
     Png,
     /// 32-bit float linear RGB with [`ImageMeta`] in the header: exact, mergeable.
     Exr,
@@ -185,8 +243,8 @@ fn unsupported(path: &Path, supported: &'static str) -> FilmError {
 
 /// Writes `img` to `path`; the format comes from the extension.
 ///
-/// EXR stores the exact floats and `meta`; PNG ignores `meta` and applies
-/// `png`. The file is encoded in memory, written to a hidden temporary file
+/// EXR stores the exact floats and `meta` as header attributes; PNG stores the 8-bit preview
+/// after `png`'s exposure, with `meta` as text chunks. The file is encoded in memory, written to a hidden temporary file
 /// in the target directory and renamed over `path`, so readers see either
 /// the old file or the complete new one, and a failure leaves neither a
 /// partial target nor a temporary file. A missing parent directory is
@@ -208,10 +266,41 @@ pub fn write_image(
         });
     }
     let bytes = match format {
-        ImageFormat::Png => raster::encode_png(path, img, png)?,
+        ImageFormat::Png => raster::encode_png(path, img, meta, png)?,
         ImageFormat::Exr => exr::encode_exr(path, img, meta)?,
     };
     write_atomic(path, &bytes)
+}
+
+/// An image file's size and provenance, read from its header.
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub struct ImageHeader {
+    /// Width in pixels.
+    pub width: u32,
+    /// Height in pixels.
+    pub height: u32,
+    /// The `prism:*` attributes (EXR) or text chunks (PNG), if the file has them.
+    pub meta: Option<ImageMeta>,
+}
+
+/// The size and provenance of a PNG or EXR file written by [`write_image`], without decoding
+/// its pixels: what `--resume` checks before it keeps a frame.
+pub fn read_header(path: &Path) -> Result<ImageHeader, FilmError> {
+    let format = ImageFormat::from_path(path)?;
+    // Both formats put what is read here first (the PNG text chunks before the pixels).
+    let bytes = crate::files::read_prefix(path, 1 << 20).map_err(|error| FilmError::Read {
+        path: path.to_path_buf(),
+        error,
+    })?;
+    let (width, height, meta) = match format {
+        ImageFormat::Png => raster::png_header(path, &bytes)?,
+        ImageFormat::Exr => exr::exr_header(path, &bytes)?,
+    };
+    Ok(ImageHeader {
+        width,
+        height,
+        meta,
+    })
 }
 
 /// Reads an image as linear RGB, choosing the decoder by extension.

@@ -4,7 +4,7 @@
 use std::io::Cursor;
 use std::path::Path;
 
-use super::{FilmError, Image, srgb_decode, srgb_encode};
+use super::{FilmError, Image, ImageMeta, srgb_decode, srgb_encode};
 
 /// Settings for the 8-bit PNG preview.
 #[derive(Clone, Copy, Debug, PartialEq, Default)]
@@ -14,13 +14,14 @@ pub struct PngOptions {
     pub exposure: f32,
 }
 
+/// The 8-bit sRGB preview of `img`, with `meta` as `tEXt` chunks before the pixels (so a
+/// header read finds them without decoding the image).
 pub(super) fn encode_png(
     path: &Path,
     img: &Image,
+    meta: &ImageMeta,
     opts: &PngOptions,
 ) -> Result<Vec<u8>, FilmError> {
-    use image::ImageEncoder;
-
     let scale = opts.exposure.exp2();
     let to_byte = |v: f32| -> u8 {
         if !v.is_finite() {
@@ -35,14 +36,44 @@ pub(super) fn encode_png(
     };
     let raw: Vec<u8> = img.pixels.iter().flat_map(|p| p.map(to_byte)).collect();
 
+    let encode_err = |e: png::EncodingError| FilmError::Encode {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    };
     let mut out = Vec::new();
-    image::codecs::png::PngEncoder::new(&mut out)
-        .write_image(&raw, img.width, img.height, image::ExtendedColorType::Rgb8)
-        .map_err(|e| FilmError::Encode {
+    let mut enc = png::Encoder::new(&mut out, img.width, img.height);
+    enc.set_color(png::ColorType::Rgb);
+    enc.set_depth(png::BitDepth::Eight);
+    for (name, value) in meta.attributes() {
+        enc.add_text_chunk(name.to_owned(), value)
+            .map_err(encode_err)?;
+    }
+    let mut writer = enc.write_header().map_err(encode_err)?;
+    writer.write_image_data(&raw).map_err(encode_err)?;
+    writer.finish().map_err(encode_err)?;
+    Ok(out)
+}
+
+/// The size and provenance (`prism:*` text chunks) of a PNG file, from the chunks before its
+/// pixels.
+pub(super) fn png_header(
+    path: &Path,
+    bytes: &[u8],
+) -> Result<(u32, u32, Option<ImageMeta>), FilmError> {
+    let reader = png::Decoder::new(Cursor::new(bytes))
+        .read_info()
+        .map_err(|e| FilmError::Decode {
             path: path.to_path_buf(),
             message: e.to_string(),
         })?;
-    Ok(out)
+    let info = reader.info();
+    let text = |name: &str| {
+        info.uncompressed_latin1_text
+            .iter()
+            .find(|c| c.keyword == name)
+            .map(|c| c.text.clone())
+    };
+    Ok((info.width, info.height, ImageMeta::from_attributes(text)))
 }
 
 /// How the integer samples of a file encode light.

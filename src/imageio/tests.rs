@@ -12,6 +12,8 @@ const META: ImageMeta = ImageMeta {
     sample_offset: 1 << 40,
     scene_hash: 0xfedc_ba98_7654_3210,
     simd: Some(16),
+    complete: true,
+    settings: Some(0x0123_4567_89ab_cdef),
 };
 
 fn entries(dir: &Path) -> Vec<String> {
@@ -124,6 +126,48 @@ fn exr_round_trip_is_bit_exact_with_meta() {
 }
 
 #[test]
+fn headers_of_both_formats_give_size_and_provenance() {
+    let dir = tempfile::tempdir().unwrap();
+    let incomplete = ImageMeta {
+        complete: false,
+        ..META
+    };
+    for name in ["h.exr", "h.png"] {
+        let path = dir.path().join(name);
+        for meta in [META, incomplete] {
+            write_image(&path, &hdr_image(), &meta, &PngOptions::default()).unwrap();
+            let h = read_header(&path).unwrap();
+            let img = hdr_image();
+            assert_eq!((h.width, h.height), (img.width, img.height), "{name}");
+            assert_eq!(h.meta, Some(meta), "{name}");
+        }
+    }
+    // Files from other tools (or from before the attributes existed) have no provenance;
+    // a file without `prism:complete` counts as complete.
+    let plain = dir.path().join("plain.png");
+    image::RgbImage::new(3, 2).save(&plain).unwrap();
+    let h = read_header(&plain).unwrap();
+    assert_eq!((h.width, h.height, h.meta), (3, 2, None));
+    let m = ImageMeta::from_attributes(|k| match k {
+        ATTR_SPP => Some("8".into()),
+        ATTR_SAMPLE_OFFSET => Some("0".into()),
+        ATTR_SCENE_HASH => Some("0x1f".into()),
+        _ => None,
+    });
+    assert_eq!(
+        m,
+        Some(ImageMeta {
+            spp: 8,
+            sample_offset: 0,
+            scene_hash: 0x1f,
+            simd: None,
+            complete: true,
+            settings: None,
+        })
+    );
+}
+
+#[test]
 fn exr_files_of_one_image_are_identical_bytes() {
     // Each encode fills a fresh hash map of attributes, whose order is random: unsorted,
     // eight encodes agree only by chance (odds about 1 in 6^7).
@@ -150,12 +194,16 @@ fn exr_meta_extremes_round_trip() {
             sample_offset: 0,
             scene_hash: 0,
             simd: None,
+            complete: false,
+            settings: None,
         },
         ImageMeta {
             spp: u32::MAX,
             sample_offset: u64::MAX,
             scene_hash: u64::MAX,
             simd: Some(u32::MAX),
+            complete: true,
+            settings: Some(u64::MAX),
         },
     ] {
         write_image(

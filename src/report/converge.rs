@@ -217,6 +217,7 @@ fn timed_render(
             time_limit: None,
             lanes: crate::simd::Lanes::auto(),
             monochromatic: None,
+            stop: None,
         },
         &|_| {},
     );
@@ -273,6 +274,8 @@ fn reference(opts: &ConvergeOptions) -> Result<(Image, Option<f64>), String> {
         sample_offset: 0,
         scene_hash: scene.hash,
         simd: None,
+        complete: true,
+        settings: None,
     };
     film::write_image(&path, &img, &meta, &PngOptions::default()).map_err(|e| e.to_string())?;
     film::write_atomic(&note, format!("{est:e}\n").as_bytes()).map_err(|e| e.to_string())?;

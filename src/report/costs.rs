@@ -17,6 +17,7 @@ fn ns_per_sample(rs: &crate::scene::RenderScene, spp: u32, runs: usize) -> f64 {
         time_limit: None,
         lanes: crate::simd::Lanes::auto(),
         monochromatic: None,
+        stop: None,
     };
     let mut t: Vec<f64> = (0..runs)
         .map(|_| {
