@@ -473,6 +473,85 @@ fn sample_and_frame_ranges_cannot_wrap() {
 }
 
 #[test]
+fn integers_too_large_for_their_type_are_refused_with_the_range() {
+    let d = tempfile::tempdir().unwrap();
+    for (from, to, want) in [
+        (
+            "spp: 2)",
+            "spp: 99999999999)",
+            "field `spp`: the number is out of range: must be in 1..=4294967295",
+        ),
+        (
+            "spp: 2)",
+            "spp: 2, seed: -1)",
+            "field `seed`: the number is out of range: must be in 0..=18446744073709551615",
+        ),
+        (
+            "width: 8,",
+            "width: -8,",
+            "field `width`: the number is out of range: must be in 1..=65536 pixels",
+        ),
+    ] {
+        let scene = write(d.path(), "s.ron", &GOOD.replace(from, to));
+        let err = fails(&["render", scene.to_str().unwrap()]);
+        assert!(
+            err.starts_with("error: ") && err.contains("s.ron:2:") && err.contains(want),
+            "{err}\nwanted: {want}"
+        );
+    }
+}
+
+/// Errors found after parsing carry the position of the value at fault, or of its entity
+/// when the field is absent.
+#[test]
+fn errors_about_entities_after_parsing_carry_their_position() {
+    let d = tempfile::tempdir().unwrap();
+    let ball = "material: Diffuse(albedo: Rgb(0.5, 0.5, 0.5))";
+    // Replace `from` by `to`; the error must point at the first `marker` and say `says`.
+    let cases = [
+        (
+            ball,
+            "material: Diffuse(albedo: Rgb(0.5, 0.5, 0.5)), light: Point(position: \
+             (0.0, 0.0, 0.0), intensity: Rgb(1.0, 1.0, 1.0))",
+            "Point(",
+            "entity \"ball\": field `light`: a point or spot light has no shape or material",
+        ),
+        (
+            "shape: Sphere(center: (0.0, 0.0, 0.0), radius: 1.0),\n         material: Diffuse(albedo: Rgb(0.5, 0.5, 0.5))",
+            "shape: Box(min: (0.0, 0.0, 0.0), max: (1.0, 1.0, 1.0)),\n         material: Light(emission: Rgb(1.0, 1.0, 1.0))",
+            "Light(",
+            "entity \"ball\": field `material`: a Light needs a Sphere, Rect or Disk",
+        ),
+        (
+            ", material: Diffuse(albedo: Rgb(0.5, 0.5, 0.5))",
+            "",
+            "(name: \"ball\"",
+            "entity \"ball\": field `material`: a shape needs a material",
+        ),
+        (
+            "look_at: (0.0, 0.0, 0.0)",
+            "look_at: (0.0, 0.0, 4.0)",
+            "(0.0, 0.0, 4.0)),",
+            "entity \"camera\": field `look_at`:",
+        ),
+    ];
+    for (from, to, marker, says) in cases {
+        let text = GOOD.replace(",\n         material", ", material").replace(
+            &from.replace(",\n         material", ", material"),
+            &to.replace(",\n         material", ", material"),
+        );
+        assert_ne!(text, GOOD.replace(",\n         material", ", material"));
+        let at = text.find(marker).unwrap();
+        let line = text[..at].matches('\n').count() + 1;
+        let col = at - text[..at].rfind('\n').map_or(0, |i| i + 1) + 1;
+        let scene = write(d.path(), "s.ron", &text);
+        let err = fails(&["render", scene.to_str().unwrap()]);
+        let want = format!("s.ron:{line}:{col}: {says}");
+        assert!(err.contains(&want), "{err}\nwanted: {want}\n{text}");
+    }
+}
+
+#[test]
 fn bad_values_are_refused_with_their_valid_range() {
     let d = tempfile::tempdir().unwrap();
     let with = |name: &str, material: &str| {

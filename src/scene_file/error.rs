@@ -32,6 +32,12 @@ pub enum SceneError {
     Entity {
         /// The scene file.
         path: PathBuf,
+        /// Line and column (1-based, columns in characters) of the value at fault, or of its
+        /// entity when the field is absent; `None` until the error is located in the text.
+        at: Option<(u32, u32)>,
+        /// Where the value at fault is, as `--set` writes a path (`entities[3].material`,
+        /// `camera.look_at`): what `at` is found from.
+        key: Box<str>,
         /// Name of the entity.
         entity: String,
         /// The field at fault.
@@ -73,17 +79,24 @@ impl fmt::Display for SceneError {
             }
             SceneError::Entity {
                 path,
+                at,
                 entity,
                 field,
                 message,
-            } => write!(
-                f,
-                "{}: entity {}: field `{}`: {}",
-                path.display(),
-                crate::components::quoted(entity),
-                field,
-                message
-            ),
+                ..
+            } => {
+                write!(f, "{}", path.display())?;
+                if let Some((line, col)) = at {
+                    write!(f, ":{line}:{col}")?;
+                }
+                write!(
+                    f,
+                    ": entity {}: field `{}`: {}",
+                    crate::components::quoted(entity),
+                    field,
+                    message
+                )
+            }
             SceneError::Override { key, message } => write!(f, "--set {key}: {message}"),
         }
     }
@@ -96,6 +109,43 @@ impl std::error::Error for SceneError {
             _ => None,
         }
     }
+}
+
+impl SceneError {
+    /// `self` with the position of an [`SceneError::Entity`] error's value in `text`, the
+    /// scene's text, filled in.
+    pub(crate) fn located(self, text: &str) -> SceneError {
+        match self {
+            SceneError::Entity {
+                path,
+                at: None,
+                key,
+                entity,
+                field,
+                message,
+            } => SceneError::Entity {
+                path,
+                at: super::patch::locate(text, &key).map(|o| {
+                    let (l, c) = line_col(text, o);
+                    (l as u32, c as u32)
+                }),
+                key,
+                entity,
+                field,
+                message,
+            },
+            e => e,
+        }
+    }
+}
+
+/// The 1-based (line, column) of byte offset `at`; columns count characters.
+pub(crate) fn line_col(text: &str, at: usize) -> (usize, usize) {
+    let at = at.min(text.len());
+    let before = &text[..at];
+    let line = before.matches('\n').count() + 1;
+    let start = before.rfind('\n').map_or(0, |i| i + 1);
+    (line, before[start..].chars().count() + 1)
 }
 
 /// Byte offset of a 1-based (line, column) position; columns count characters.
@@ -273,5 +323,68 @@ mod tests {
         let t = "ab\ncd\n";
         assert_eq!(offset_of(t, 2, 2), 4);
         assert_eq!(offset_of(t, 1, 1), 0);
+        for (line, col) in [(1, 1), (1, 3), (2, 1), (2, 2), (3, 1)] {
+            assert_eq!(line_col(t, offset_of(t, line, col)), (line, col));
+        }
+        // Columns count characters, not bytes.
+        assert_eq!(line_col("é(x", 3), (1, 3));
+    }
+
+    /// Errors found after parsing (meshes, textures, lights on boxes, a missing material, the
+    /// camera) point at the value at fault, or at its entity when the field is absent.
+    #[test]
+    fn errors_after_parsing_are_located() {
+        use crate::scene_file::load_str;
+        let scene = |entity: &str, camera: &str| {
+            format!(
+                "Scene(\n  render: (width: 8, height: 8),\n  camera: (position: (0.0, 0.0, 5.0), \
+                 look_at: {camera}),\n  entities: [\n    (name: \"ok\", shape: Sphere(center: \
+                 (0.0, 0.0, 0.0), radius: 1.0), material: Diffuse(albedo: Rgb(0.5, 0.5, 0.5))),\n    \
+                 {entity},\n  ],\n)"
+            )
+        };
+        let path = std::path::Path::new("s.ron");
+        // The entity, the camera's look_at, where the error must point (the first match of
+        // the marker, plus an offset) and what it must say there.
+        let cases = [
+            (
+                "(name: \"bare\", shape: Sphere(center: (0.0, 0.0, 0.0), radius: 1.0))",
+                "(0.0, 0.0, 0.0)",
+                ("(name: \"bare\"", 0),
+                "entity \"bare\": field `material`:",
+            ),
+            (
+                "(name: \"lit box\", shape: Box(min: (0.0, 0.0, 0.0), max: (1.0, 1.0, 1.0)), \
+                 material: Light(emission: Rgb(1.0, 1.0, 1.0)))",
+                "(0.0, 0.0, 0.0)",
+                ("Light(emission", 0),
+                "entity \"lit box\": field `material`:",
+            ),
+            (
+                "(name: \"m\", shape: Mesh(path: \"missing.obj\"), material: Mirror(tint: \
+                 Rgb(1.0, 1.0, 1.0)))",
+                "(0.0, 0.0, 0.0)",
+                ("Mesh(path", 0),
+                "entity \"m\": field `shape`:",
+            ),
+            (
+                "(name: \"p\", shape: Sphere(center: (0.0, 0.0, 0.0), radius: 1.0), \
+                 material: Mirror(tint: Rgb(1.0, 1.0, 1.0)))",
+                "(0.0, 0.0, 5.0)",
+                ("look_at: ", 9),
+                "entity \"camera\": field `look_at`:",
+            ),
+        ];
+        for (entity, look_at, (marker, skip), says) in cases {
+            let text = scene(entity, look_at);
+            let msg = match load_str(&text, path, &[]) {
+                Err(e) => e.to_string(),
+                Ok(_) => panic!("{text} loaded"),
+            };
+            let (line, col) = line_col(&text, text.find(marker).unwrap() + skip);
+            let want = format!("s.ron:{line}:{col}: {says}");
+            assert!(line > 2 && col > 1, "{want}");
+            assert!(msg.starts_with(&want), "{msg}\nwanted: {want}\n{text}");
+        }
     }
 }

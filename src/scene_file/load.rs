@@ -154,7 +154,7 @@ fn load_text(
             },
         )?;
     }
-    build_world(scene, path, hash, assets)
+    build_world(scene, path, hash, assets).map_err(|e| e.located(&patched))
 }
 
 /// Deserialises the schema, turning RON's error position into file:line:col with the entity
@@ -173,6 +173,13 @@ pub fn parse(text: &str, path: &Path) -> Result<schema::Scene, SceneError> {
             field = Some(name.to_string());
             message = why.to_string();
         }
+        // RON's own words name no range.
+        if matches!(e.code, ron::Error::IntegerOutOfBounds) {
+            message = format!(
+                "the number is out of range: must be {}",
+                integer_range(field.as_deref())
+            );
+        }
         // A bare tuple where an enum is expected (`albedo: (0.8, 0.3, 0.2)`): RON's own words
         // do not say what is missing.
         if matches!(e.code, ron::Error::ExpectedIdentifier) && text[at..].starts_with('(') {
@@ -190,6 +197,21 @@ pub fn parse(text: &str, path: &Path) -> Result<schema::Scene, SceneError> {
             message,
         }
     })
+}
+
+/// The valid range of an integer field, for a number too large (or negative) for its type.
+fn integer_range(field: Option<&str>) -> &'static str {
+    match field {
+        Some("width" | "height") => "in 1..=65536 pixels",
+        Some("spp") => "in 1..=4294967295 samples per pixel",
+        Some("max_depth") => "in 0..=1024 scattering events",
+        Some("blades") => "0 (round) or 3..=64",
+        Some("wavelengths") => "1 or 4",
+        Some("fps") => "in 1..=1000",
+        Some("seed") => "in 0..=18446744073709551615",
+        Some("rr_depth" | "frame") => "in 0..=4294967295",
+        _ => "a whole number in 0..=4294967295 (0..=18446744073709551615 for `seed`)",
+    }
 }
 
 /// RON options for scene files: optional fields may be written bare (`lens: (..)`) or as
@@ -330,6 +352,8 @@ fn build_world(
     {
         return Err(SceneError::Entity {
             path: path.to_path_buf(),
+            at: None,
+            key: "camera.look_at".into(),
             entity: "camera".into(),
             field: "look_at",
             message: "look_at must differ from position, and up must not be parallel to the view direction".into(),
@@ -388,6 +412,8 @@ fn build_world(
             {
                 return Err(SceneError::Entity {
                     path: path.to_path_buf(),
+                    at: None,
+                    key: format!("animation.keyframes[{i}].look_at").into(),
                     entity: format!("animation keyframe {i}"),
                     field: "look_at",
                     message: "look_at must differ from position, and up must not be parallel to the view direction".into(),
@@ -412,6 +438,8 @@ fn build_world(
         let name = e.name.clone().unwrap_or_else(|| format!("#{i}"));
         let err = |field: &'static str, message: String| SceneError::Entity {
             path: path.to_path_buf(),
+            at: None,
+            key: format!("entities[{i}].{field}").into(),
             entity: name.clone(),
             field,
             message,

@@ -103,13 +103,60 @@ pub fn apply(text: &str, key: &str, value: &str) -> Result<(String, Range<usize>
     Ok((new, v.start..v.start + value.len()))
 }
 
+/// The byte offset in `text` of the value at `key` (`entities[3].material`, `camera.look_at`,
+/// `animation.keyframes[2]`), or of the deepest value on the way to it that the text has (the
+/// entity, when the field is absent): where an error about that value points. `None` when not
+/// even the first step is found.
+pub fn locate(text: &str, key: &str) -> Option<usize> {
+    let steps = parse_steps(key).ok()?;
+    let b = text.as_bytes();
+    let top = skip_attributes(b, skip_ws(b, 0));
+    let mut cur = top..text.len();
+    let mut found = None;
+    for step in &steps {
+        let next = match step {
+            Step::Field(name) => struct_body(b, cur.start, cur.end)
+                .and_then(|body| fields(b, body))
+                .and_then(|fs| fs.into_iter().find(|f| &text[f.0.clone()] == name))
+                .map(|f| f.1),
+            Step::Index(i) => list(b, cur.clone()).and_then(|l| l.get(*i).cloned()),
+            Step::Named(n) => list(b, cur.clone()).and_then(|l| {
+                l.into_iter()
+                    .find(|e| name_of(text, e.clone()).as_deref() == Some(n.as_str()))
+            }),
+        };
+        match next {
+            Some(v) => {
+                found = Some(v.start);
+                cur = v;
+            }
+            None => break,
+        }
+    }
+    found
+}
+
 fn parse_path(key: &str) -> Result<Vec<Step>, String> {
-    let bad = |why: &str| {
-        format!(
-            "{why}; an entity path is entities[INDEX] or entities[\"NAME\"] then .field steps, \
-             e.g. entities[\"floor\"].material.albedo"
-        )
-    };
+    let steps = parse_steps(key)?;
+    if steps.len() < 2
+        || steps[0] != Step::Field("entities".into())
+        || matches!(steps[1], Step::Field(_))
+    {
+        return Err(path_help("no entity selected"));
+    }
+    Ok(steps)
+}
+
+fn path_help(why: &str) -> String {
+    format!(
+        "{why}; an entity path is entities[INDEX] or entities[\"NAME\"] then .field steps, \
+         e.g. entities[\"floor\"].material.albedo"
+    )
+}
+
+/// The steps of `key`, fields joined by `.` and list elements as `[INDEX]` or `["NAME"]`.
+fn parse_steps(key: &str) -> Result<Vec<Step>, String> {
+    let bad = path_help;
     let mut steps = Vec::new();
     let mut rest = key;
     let mut first = true;
@@ -148,12 +195,6 @@ fn parse_path(key: &str) -> Result<Vec<Step>, String> {
             rest = &r[end..];
         }
         first = false;
-    }
-    if steps.len() < 2
-        || steps[0] != Step::Field("entities".into())
-        || matches!(steps[1], Step::Field(_))
-    {
-        return Err(bad("no entity selected"));
     }
     Ok(steps)
 }
@@ -392,6 +433,22 @@ mod tests {
         );
         let t = set("entities[\"floor\"].name", "\"ground\"").unwrap();
         assert!(t.contains("(name: \"ground\", shape"), "{t}");
+    }
+
+    #[test]
+    fn locates_values_or_the_deepest_part_present() {
+        let at = |key: &str| locate(SCENE, key).map(|o| &SCENE[o..o + 12]);
+        assert_eq!(at("camera.look_at"), Some("(0.0, 1.0, 0"));
+        assert_eq!(at("entities[1].material"), Some("Light(emissi"));
+        assert_eq!(
+            at("entities[\"floor\"].material.albedo"),
+            Some("(0.7, 0.7, 0")
+        );
+        // An absent field: its entity; an absent entity: the list.
+        assert_eq!(at("entities[2].texture"), Some("(shape: Sphe"));
+        assert_eq!(at("entities[9].material"), Some("[\n        (n"));
+        assert_eq!(locate(SCENE, "lens.aperture"), None);
+        assert_eq!(locate(SCENE, "entities[x"), None);
     }
 
     #[test]
