@@ -44,7 +44,11 @@ fn main() -> ExitCode {
     match prism::cli::run(cli) {
         Ok(()) => ExitCode::SUCCESS,
         Err(e) => {
-            eprintln!("error: {e}");
+            // A path or value echoed from a file must not break the line or drive the terminal.
+            eprintln!(
+                "error: {}",
+                prism::components::escape_controls(&e.to_string())
+            );
             ExitCode::from(e.exit_code())
         }
     }

@@ -472,6 +472,106 @@ fn sample_and_frame_ranges_cannot_wrap() {
     );
 }
 
+/// The hostile files of the hardening list, through the binary: each refused with one line
+/// naming the file and what it claims, before anything is allocated for it.
+#[test]
+fn files_claiming_huge_sizes_are_refused_by_the_commands() {
+    let d = tempfile::tempdir().unwrap();
+    let scenes = d.path().join("scenes");
+    std::fs::create_dir_all(&scenes).unwrap();
+    let with_entity = |name: &str, entity: &str| {
+        write(
+            &scenes,
+            name,
+            &GOOD.replace("    ],\n)", &format!("        {entity},\n    ],\n)")),
+        )
+    };
+    // PLY headers claiming 2⁶⁴ − 1 and 10¹¹ vertices (a panic and an abort, once).
+    for (file, count, format) in [
+        ("huge.ply", "18446744073709551615", "ascii"),
+        ("big.ply", "100000000000", "binary_little_endian"),
+    ] {
+        write(
+            &scenes,
+            file,
+            &format!(
+                "ply\nformat {format} 1.0\nelement vertex {count}\nproperty float x\n\
+                 property float y\nproperty float z\nend_header\n0 0 0\n"
+            ),
+        );
+        let scene = with_entity(
+            "m.ron",
+            &format!(
+                "(name: \"m\", shape: Mesh(path: \"{file}\"), material: Diffuse(albedo: \
+                 Rgb(0.5, 0.5, 0.5)))"
+            ),
+        );
+        let err = fails(&["render", scene.to_str().unwrap()]);
+        assert!(
+            err.contains(file) && err.contains(&format!("claims {count}")),
+            "{err}"
+        );
+    }
+    // An EXR whose data window claims 200000 × 200000: compare and merge refuse it.
+    let exr = d.path().join("huge.exr");
+    let meta = prism::film::ImageMeta {
+        spp: 1,
+        sample_offset: 0,
+        scene_hash: 0,
+        simd: None,
+        complete: true,
+        settings: None,
+    };
+    prism::film::write_image(
+        &exr,
+        &prism::film::Image::filled(1, 1, [0.5; 3]),
+        &meta,
+        &prism::film::PngOptions::default(),
+    )
+    .unwrap();
+    let mut bytes = std::fs::read(&exr).unwrap();
+    let key = b"dataWindow\0box2i\0";
+    let at = bytes.windows(key.len()).position(|w| w == key).unwrap() + key.len() + 4;
+    for k in [2, 3] {
+        bytes[at + 4 * k..at + 4 * k + 4].copy_from_slice(&199_999i32.to_le_bytes());
+    }
+    std::fs::write(&exr, &bytes).unwrap();
+    let e = exr.to_str().unwrap();
+    for args in [
+        vec!["compare", e, e],
+        vec![
+            "merge",
+            e,
+            e,
+            "-o",
+            d.path().join("m.exr").to_str().unwrap(),
+        ],
+    ] {
+        let err = fails(&args);
+        assert!(
+            err.contains("huge.exr") && err.contains("200000×200000"),
+            "{args:?}: {err}"
+        );
+    }
+    // A 22000 × 22000 all-zero PNG as a texture: it passed the decoder's own limit and then
+    // aborted in the conversion to f32 RGB (12 bytes per pixel).
+    // (Its header is what matters: the file here stops after it.)
+    let png = scenes.join("zero.png");
+    let mut enc = png::Encoder::new(std::fs::File::create(&png).unwrap(), 22_000, 22_000);
+    enc.set_color(png::ColorType::Grayscale);
+    let mut w = enc.write_header().unwrap();
+    // An empty data chunk: decoders read the header up to the first one.
+    w.write_chunk(png::chunk::IDAT, &[]).unwrap();
+    drop(w);
+    let scene = with_entity(
+        "t.ron",
+        "(name: \"t\", shape: Rect(center: (0.0, 0.0, -2.0), u: (1.0, 0.0, 0.0), v: (0.0, 1.0, 0.0)), \
+         material: Diffuse(albedo: Rgb(0.5, 0.5, 0.5)), texture: (albedo: Image(path: \"zero.png\")))",
+    );
+    let err = fails(&["render", scene.to_str().unwrap()]);
+    assert!(err.contains("zero.png") && err.contains("22000"), "{err}");
+}
+
 #[test]
 fn integers_too_large_for_their_type_are_refused_with_the_range() {
     let d = tempfile::tempdir().unwrap();

@@ -44,6 +44,24 @@ pub fn quoted(name: &str) -> String {
     out
 }
 
+/// `text` with its control characters escaped (`\n`, `\u{1b}`), so that a file path or value
+/// from a scene, echoed in a message, keeps the message on one line and cannot drive the
+/// terminal.
+pub fn escape_controls(text: &str) -> std::borrow::Cow<'_, str> {
+    if !text.chars().any(char::is_control) {
+        return std::borrow::Cow::Borrowed(text);
+    }
+    let mut out = String::with_capacity(text.len() + 8);
+    for c in text.chars() {
+        if c.is_control() {
+            out.extend(c.escape_debug());
+        } else {
+            out.push(c);
+        }
+    }
+    std::borrow::Cow::Owned(out)
+}
+
 /// Object-to-world placement: scale, then rotation R = Rz·Ry·Rx (degrees), then translation.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub struct Transform {

@@ -46,7 +46,7 @@ pub enum FilmError {
         error: io::Error,
     },
     /// The PNG or EXR encoder refused the image.
-    #[error("cannot encode '{path}': {message}")]
+    #[error("cannot encode '{path}': {}", one_line(.message))]
     Encode {
         /// The file that was to be written.
         path: PathBuf,
@@ -55,7 +55,7 @@ pub enum FilmError {
     },
     /// The file's contents are not a valid image of its format, or are valid but unsupported
     /// (subsampled EXR channels, sides beyond `u32`).
-    #[error("cannot decode '{path}': {message}")]
+    #[error("cannot decode '{path}': {}", one_line(.message))]
     Decode {
         /// The file being read.
         path: PathBuf,
@@ -137,4 +137,14 @@ pub(crate) fn io_reason(error: &io::Error) -> String {
         Some(first) => first.to_lowercase().chain(chars).collect(),
         None => String::new(),
     }
+}
+
+/// A decoder's message on one line: some end theirs with a newline or spread it over several.
+fn one_line(message: &str) -> String {
+    let lines: Vec<&str> = message
+        .lines()
+        .map(str::trim)
+        .filter(|l| !l.is_empty())
+        .collect();
+    lines.join("; ")
 }

@@ -75,7 +75,7 @@ impl fmt::Display for SceneError {
                 if let Some(fi) = field {
                     write!(f, "field `{fi}`: ")?;
                 }
-                f.write_str(message)
+                f.write_str(&crate::components::escape_controls(message))
             }
             SceneError::Entity {
                 path,
@@ -94,10 +94,15 @@ impl fmt::Display for SceneError {
                     ": entity {}: field `{}`: {}",
                     crate::components::quoted(entity),
                     field,
-                    message
+                    crate::components::escape_controls(message)
                 )
             }
-            SceneError::Override { key, message } => write!(f, "--set {key}: {message}"),
+            SceneError::Override { key, message } => write!(
+                f,
+                "--set {}: {}",
+                crate::components::escape_controls(key),
+                crate::components::escape_controls(message)
+            ),
         }
     }
 }
