@@ -211,6 +211,7 @@ fn merge_refuses_parts_that_do_not_belong_together() {
     exr(s, 4, 8, &p("gap.exr"), &[]);
     exr(s, 4, 4, &p("seed.exr"), &["--seed", "9"]);
     exr(s, 4, 4, &p("small.exr"), &["--size", "16x12"]);
+    exr(s, 4, 4, &p("forced.exr"), &["--force", "lens"]);
     ok(prism()
         .args(["render", s, "--quiet", "--spp", "4", "-o"])
         .arg(p("a.png")));
@@ -232,6 +233,7 @@ fn merge_refuses_parts_that_do_not_belong_together() {
             || merge("a.exr", "small.exr").contains("32x24")
     );
     assert!(merge("a.exr", "a.png").contains("header"));
+    assert!(merge("a.exr", "forced.exr").contains("different --force settings"));
     // A part that claims no samples averaged to an all-NaN image.
     let (img, meta) = prism::film::read_image(&p("a.exr")).unwrap();
     let mut meta = meta.unwrap();

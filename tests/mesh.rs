@@ -1156,6 +1156,22 @@ fn ply_errors_name_file_and_line() {
         );
         assert!(e.to_string().contains(&format!("claims {count}")), "{e}");
     }
+    // More faces than the memory budget allows, refused at the line that claims them.
+    let e = err_of(
+        dir.path(),
+        "faces.ply",
+        "ply\nformat binary_little_endian 1.0\nelement vertex 3\nproperty float x\n\
+         property float y\nproperty float z\nelement face 40000000\n\
+         property list uchar int vertex_indices\nend_header\n",
+    );
+    assert!(
+        matches!(e, MeshError::Malformed { line: Some(7), .. }),
+        "{e}"
+    );
+    assert!(
+        e.to_string().contains("more than the 33554432 triangles"),
+        "{e}"
+    );
     let e = err_of(dir.path(), "magic.ply", "solid\n");
     assert!(
         matches!(e, MeshError::Malformed { line: Some(1), .. }),

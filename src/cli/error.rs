@@ -129,6 +129,18 @@ pub enum CliError {
         .0.display()
     )]
     MergeNoHeader(PathBuf),
+    /// Two merge parts were rendered with different `--force` settings (`prism:settings`).
+    #[error(
+        "'{}' and '{}' were rendered with different --force settings (prism:settings differ)",
+        .first.display(),
+        .other.display()
+    )]
+    MergeSettings {
+        /// The first part.
+        first: PathBuf,
+        /// The part whose settings differ.
+        other: PathBuf,
+    },
     /// Two merge parts come from different scenes or settings.
     #[error(
         "'{}' and '{}' come from different scenes or settings (scene hash {first_hash:#018x} vs {other_hash:#018x})",

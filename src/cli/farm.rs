@@ -82,6 +82,14 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<(u32, u64), CliError> {
                     other_width: w,
                 });
             }
+            if let (Some(s0), Some(s)) = (m0.settings, meta.settings)
+                && s0 != s
+            {
+                return Err(CliError::MergeSettings {
+                    first: p0.clone(),
+                    other: p.clone(),
+                });
+            }
             if (i0.width, i0.height) != (img.width, img.height) {
                 return Err(CliError::MergeSizes {
                     first: p0.clone(),

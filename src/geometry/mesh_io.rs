@@ -93,6 +93,48 @@ fn malformed(path: &Path, line: Option<usize>, message: impl Into<String>) -> Me
 // ---------------------------------------------------------------------------------------------
 // OBJ
 
+/// The memory a mesh (OBJ or PLY) may take while it loads: 16 GiB.
+pub const MESH_MEMORY_BUDGET: u64 = 16 << 30;
+/// Bytes per triangle while a mesh loads: the file's text, the parser's arrays, their
+/// copy, the mesh's own (positions, normals, UVs, indices, welding) and its kd-tree. Measured
+/// about 400 at the peak (a 2M-triangle grid: 802 MB resident); 512 leaves a margin.
+const BYTES_PER_TRIANGLE: u64 = 512;
+const MAX_OBJ_TRIANGLES: usize = crate::kdtree::MAX_PRIMS;
+
+/// Refuses an OBJ text whose faces make more than `limit` triangles.
+fn check_obj_triangles(path: &Path, text: &[u8], limit: u64) -> Result<(), MeshError> {
+    let triangles = obj_triangles(text);
+    if triangles > limit {
+        return Err(MeshError::TooLarge {
+            path: Some(path.to_path_buf()),
+            what: "triangles in its faces (counted before loading; the limit is 16 GiB at \
+                   512 bytes per triangle)",
+            count: usize::try_from(triangles).unwrap_or(usize::MAX),
+            limit: limit as usize,
+        });
+    }
+    Ok(())
+}
+
+/// Triangles the faces of an OBJ text make: a face of k corners makes k − 2.
+fn obj_triangles(text: &[u8]) -> u64 {
+    text.split(|&b| b == b'\n')
+        .map(|line| {
+            let line = line.trim_ascii_start();
+            match line {
+                [b'f', b' ' | b'\t', rest @ ..] => {
+                    let corners = rest
+                        .split(|b| b.is_ascii_whitespace())
+                        .filter(|t| !t.is_empty())
+                        .count() as u64;
+                    corners.saturating_sub(2)
+                }
+                _ => 0,
+            }
+        })
+        .sum()
+}
+
 /// Loads an OBJ file (all groups and objects merged, polygons triangulated).
 pub fn load_obj(path: &Path) -> Result<TriangleMesh, MeshError> {
     let (data, text) = read_obj(path)?;
@@ -113,6 +155,14 @@ pub fn load_obj(path: &Path) -> Result<TriangleMesh, MeshError> {
 /// The arrays of an OBJ file, and its bytes for locating later errors.
 fn read_obj(path: &Path) -> Result<(MeshData, Vec<u8>), MeshError> {
     let text = read_file(path)?;
+    // An OBJ file declares no counts: its faces are counted before the parser allocates for
+    // them, and a file that would need more triangles than the kd-tree holds, or more memory
+    // than the budget, is refused.
+    check_obj_triangles(
+        path,
+        &text,
+        (MAX_OBJ_TRIANGLES as u64).min(MESH_MEMORY_BUDGET / BYTES_PER_TRIANGLE),
+    )?;
     let options = tobj::LoadOptions {
         single_index: true,
         triangulate: true,
@@ -698,6 +748,21 @@ fn parse_ply_header(path: &Path, bytes: &[u8]) -> Result<Header, MeshError> {
         }
     }
     let encoding = encoding.ok_or_else(|| malformed(path, None, "header has no `format` line"))?;
+    // Each face makes at least one triangle: the same budget as an OBJ file's.
+    let limit = (MAX_OBJ_TRIANGLES as u64).min(MESH_MEMORY_BUDGET / BYTES_PER_TRIANGLE);
+    if let Some(face) = elements.iter().find(|e| e.name == "face")
+        && face.count as u64 > limit
+    {
+        return Err(malformed(
+            path,
+            Some(face.line),
+            format!(
+                "element `face` claims {} faces, more than the {limit} triangles a mesh may have \
+                 (16 GiB at 512 bytes per triangle while loading)",
+                face.count
+            ),
+        ));
+    }
     // The header's counts are the file's claim, not its content: an element claiming more
     // instances than the bytes after the header can hold is refused before anything is
     // allocated for it (`element vertex 18446744073709551615` would overflow a reservation).
@@ -842,5 +907,25 @@ impl PlyReader<'_> {
             out.push(self.value(item, el, k, prop)?);
         }
         Ok(())
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn obj_faces_are_counted_before_loading() {
+        let text = b"v 0 0 0\nv 1 0 0\nv 0 1 0\nv 1 1 0\nf 1 2 3\n  f\t1 2 3 4\nf 1/1 2/2\n\
+                     # f 1 2 3\nvf 1 2 3\nf 1 2 3 4 5 6\n";
+        assert_eq!(obj_triangles(text), 1 + 2 + 4);
+        let p = Path::new("m.obj");
+        assert!(check_obj_triangles(p, text, 7).is_ok());
+        let e = check_obj_triangles(p, text, 6).unwrap_err().to_string();
+        assert!(
+            e.contains("m.obj") && e.contains("7 triangles in its faces"),
+            "{e}"
+        );
+        assert!(e.contains("at most 6"), "{e}");
     }
 }
