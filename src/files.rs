@@ -16,8 +16,9 @@ fn refused(message: String) -> io::Error {
     io::Error::new(io::ErrorKind::InvalidInput, message)
 }
 
-/// The bytes of the regular file at `path` (symbolic links followed), if it has at most `max`.
-pub fn read_bounded(path: &Path, max: u64) -> io::Result<Vec<u8>> {
+/// The metadata of `path` (symbolic links followed) if it is a regular file; a directory, FIFO,
+/// socket or device is refused by name.
+fn regular_file(path: &Path) -> io::Result<std::fs::Metadata> {
     let meta = std::fs::metadata(path)?;
     if meta.is_dir() {
         return Err(refused("it is a directory".into()));
@@ -27,6 +28,12 @@ pub fn read_bounded(path: &Path, max: u64) -> io::Result<Vec<u8>> {
             "it is not a regular file (a FIFO, socket or device)".into(),
         ));
     }
+    Ok(meta)
+}
+
+/// The bytes of the regular file at `path` (symbolic links followed), if it has at most `max`.
+pub fn read_bounded(path: &Path, max: u64) -> io::Result<Vec<u8>> {
+    let meta = regular_file(path)?;
     let too_big = |n: u64| refused(format!("it has {n} bytes, more than the {max} allowed"));
     if meta.len() > max {
         return Err(too_big(meta.len()));
@@ -45,15 +52,7 @@ pub fn read_bounded(path: &Path, max: u64) -> io::Result<Vec<u8>> {
 /// At most the first `max` bytes of the regular file at `path` (symbolic links followed): what
 /// a header reader needs.
 pub fn read_prefix(path: &Path, max: u64) -> io::Result<Vec<u8>> {
-    let meta = std::fs::metadata(path)?;
-    if meta.is_dir() {
-        return Err(refused("it is a directory".into()));
-    }
-    if !meta.is_file() {
-        return Err(refused(
-            "it is not a regular file (a FIFO, socket or device)".into(),
-        ));
-    }
+    let meta = regular_file(path)?;
     let mut bytes = Vec::with_capacity(meta.len().min(max) as usize);
     std::fs::File::open(path)?
         .take(max)
