@@ -99,7 +99,12 @@ pub const MESH_MEMORY_BUDGET: u64 = 16 << 30;
 /// copy, the mesh's own (positions, normals, UVs, indices, welding) and its kd-tree. Measured
 /// about 400 at the peak (a 2M-triangle grid: 802 MB resident); 512 leaves a margin.
 const BYTES_PER_TRIANGLE: u64 = 512;
-const MAX_OBJ_TRIANGLES: usize = crate::kdtree::MAX_PRIMS;
+/// The most triangles a mesh may have: the kd-tree's limit and the memory budget (2²⁵).
+pub const MAX_MESH_TRIANGLES: u64 = {
+    let budget = MESH_MEMORY_BUDGET / BYTES_PER_TRIANGLE;
+    let tree = crate::kdtree::MAX_PRIMS as u64;
+    if budget < tree { budget } else { tree }
+};
 
 /// Refuses an OBJ text whose faces make more than `limit` triangles.
 fn check_obj_triangles(path: &Path, text: &[u8], limit: u64) -> Result<(), MeshError> {
@@ -158,11 +163,7 @@ fn read_obj(path: &Path) -> Result<(MeshData, Vec<u8>), MeshError> {
     // An OBJ file declares no counts: its faces are counted before the parser allocates for
     // them, and a file that would need more triangles than the kd-tree holds, or more memory
     // than the budget, is refused.
-    check_obj_triangles(
-        path,
-        &text,
-        (MAX_OBJ_TRIANGLES as u64).min(MESH_MEMORY_BUDGET / BYTES_PER_TRIANGLE),
-    )?;
+    check_obj_triangles(path, &text, MAX_MESH_TRIANGLES)?;
     let options = tobj::LoadOptions {
         single_index: true,
         triangulate: true,
@@ -749,7 +750,7 @@ fn parse_ply_header(path: &Path, bytes: &[u8]) -> Result<Header, MeshError> {
     }
     let encoding = encoding.ok_or_else(|| malformed(path, None, "header has no `format` line"))?;
     // Each face makes at least one triangle: the same budget as an OBJ file's.
-    let limit = (MAX_OBJ_TRIANGLES as u64).min(MESH_MEMORY_BUDGET / BYTES_PER_TRIANGLE);
+    let limit = MAX_MESH_TRIANGLES;
     if let Some(face) = elements.iter().find(|e| e.name == "face")
         && face.count as u64 > limit
     {

@@ -311,11 +311,18 @@ mod tests {
         for (n, _) in &names {
             fs::write(d.path().join(n), b"x").unwrap();
         }
+        // Another host's file, a day and an hour old: stale, whoever wrote it.
+        let stale = temp_name("g.png", &other_host, 1);
+        let f = File::create(d.path().join(&stale)).unwrap();
+        let then = std::time::SystemTime::now() - STALE_AFTER - Duration::from_secs(3600);
+        f.set_modified(then).unwrap();
+        drop(f);
         fs::write(d.path().join(temp_name("f.png", &live, 0)), b"x").unwrap();
         sweep(d.path());
         for (n, kept) in &names {
             assert_eq!(d.path().join(n).exists(), *kept, "{n}");
         }
+        assert!(!d.path().join(&stale).exists(), "{stale}");
         assert_eq!(
             d.path().join(temp_name("f.png", &live, 0)).exists(),
             live_kept

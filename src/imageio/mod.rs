@@ -244,12 +244,11 @@ fn unsupported(path: &Path, supported: &'static str) -> FilmError {
 /// Writes `img` to `path`; the format comes from the extension.
 ///
 /// EXR stores the exact floats and `meta` as header attributes; PNG stores the 8-bit preview
-/// after `png`'s exposure, with `meta` as text chunks. The file is encoded in memory, written to a hidden temporary file
-/// in the target directory and renamed over `path`, so readers see either
-/// the old file or the complete new one, and a failure leaves neither a
-/// partial target nor a temporary file. A missing parent directory is
-/// created (as `mkdir -p` would), since output paths like `out/run1/x.exr`
-/// are routinely fresh.
+/// after `png`'s exposure, with `meta` as text chunks. The file is encoded in memory, written
+/// to a hidden temporary file in the target directory and renamed over `path`, so readers see
+/// either the old file or the complete new one, and a failure leaves neither a partial target
+/// nor a temporary file. A missing parent directory is created (as `mkdir -p` would), since
+/// output paths like `out/run1/x.exr` are routinely fresh.
 pub fn write_image(
     path: &Path,
     img: &Image,
