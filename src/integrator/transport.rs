@@ -714,8 +714,8 @@ impl Transport for Spectral {
         ended: u32,
         rgb: &mut [Vec3; MAX_W],
     ) {
-        // 24 table lookups per lane: only the lanes that ended pay for them, one at a time by
-        // the one-path functions (plain loads where the packet would gather for every lane).
+        // Eight table rows per lane: only the lanes that ended pay for them, one at a time
+        // (plain loads where the packet would gather for every lane).
         let mut v = [[0.0f32; MAX_W]; 3 * N_LAMBDA];
         for k in 0..N_LAMBDA {
             l.0[k].store(&mut v[k]);
@@ -726,14 +726,8 @@ impl Transport for Spectral {
         while bits != 0 {
             let i = bits.trailing_zeros() as usize;
             bits &= bits - 1;
-            let mut s = SampledSpectrum::ZERO;
-            let mut w = Wavelengths::default();
-            for k in 0..N_LAMBDA {
-                s.0[k] = v[k][i];
-                w.lambda[k] = v[N_LAMBDA + k][i];
-                w.pdf[k] = v[2 * N_LAMBDA + k][i];
-            }
-            rgb[i] = crate::spectrum::xyz_to_linear_srgb(crate::spectrum::to_xyz(&s, &w));
+            let at = |o: usize| std::array::from_fn(|k| v[o + k][i]);
+            rgb[i] = crate::spectrum::to_linear_srgb(at(0), at(N_LAMBDA), at(2 * N_LAMBDA));
         }
     }
     #[inline(always)]

@@ -195,6 +195,54 @@ pub const XYZ_TO_SRGB: Mat3 = Mat3::from_cols(
     Vec3::new(-0.498_610_8, 0.041_555_1, 1.056_971_5),
 );
 
+/// The linear sRGB matching functions, [`XYZ_TO_SRGB`] · (x̄, ȳ, z̄) per 1 nm row, divided by
+/// N · [`CIE_Y_INTEGRAL`] (the other factors of [`to_xyz`]), the fourth entry zero: one aligned
+/// load per table row turns a path's spectral sample into the film's colour.
+static RGB_BAR: [glam::Vec4; CMF_ROWS] = {
+    let m = XYZ_TO_SRGB;
+    let rows = [
+        [m.x_axis.x as f64, m.y_axis.x as f64, m.z_axis.x as f64],
+        [m.x_axis.y as f64, m.y_axis.y as f64, m.z_axis.y as f64],
+        [m.x_axis.z as f64, m.y_axis.z as f64, m.z_axis.z as f64],
+    ];
+    let norm = 1.0 / (N_LAMBDA as f64 * Y_SUM);
+    let mut t = [glam::Vec4::ZERO; CMF_ROWS];
+    let mut i = 0;
+    while i < CMF_ROWS {
+        let c = CIE_1931_2DEG[i];
+        let mut v = [0.0f32; 3];
+        let mut r = 0;
+        while r < 3 {
+            let x = rows[r][0] * c[0] + rows[r][1] * c[1] + rows[r][2] * c[2];
+            v[r] = (x * norm) as f32;
+            r += 1;
+        }
+        t[i] = glam::Vec4::new(v[0], v[1], v[2], 0.0);
+        i += 1;
+    }
+    t
+};
+
+/// Linear sRGB of one path's spectral sample: [`xyz_to_linear_srgb`] of [`to_xyz`], in one
+/// pass over a table of the sRGB matching functions (the matrix folded into the table, so it
+/// differs from the two-step form only by rounding). Terminated wavelengths (pdf 0) and
+/// wavelengths outside the table contribute nothing.
+#[inline(always)]
+pub fn to_linear_srgb(l: [f32; N_LAMBDA], lambda: [f32; N_LAMBDA], pdf: [f32; N_LAMBDA]) -> Vec3 {
+    let mut rgb = glam::Vec4::ZERO;
+    for k in 0..N_LAMBDA {
+        let x = lambda[k] - CMF_FIRST_NM as f32;
+        if pdf[k] != 0.0 && x >= 0.0 && x <= (CMF_ROWS - 1) as f32 {
+            // Through i32: x is in range, and a float → usize cast costs a dozen instructions.
+            let i = (x as i32 as usize).min(CMF_ROWS - 2);
+            let f = x - i as f32;
+            let (a, b) = (RGB_BAR[i], RGB_BAR[i + 1]);
+            rgb += (a + (b - a) * f) * (l[k] / pdf[k]);
+        }
+    }
+    rgb.truncate()
+}
+
 /// CIE XYZ → linear sRGB (D65 white: XYZ (0.9505, 1, 1.089) → (1, 1, 1)).
 #[inline(always)]
 pub fn xyz_to_linear_srgb(xyz: Vec3) -> Vec3 {
@@ -209,6 +257,41 @@ pub fn linear_srgb_to_xyz(rgb: Vec3) -> Vec3 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn one_pass_srgb_matches_xyz_then_matrix() {
+        // The folded table against the two-step form: equal up to f32 rounding of a sum of
+        // four terms and a 3×3 product (a few ulps of the largest term).
+        let mut rng = 0x2545_f491_u32;
+        let mut next = || {
+            rng ^= rng << 13;
+            rng ^= rng >> 17;
+            rng ^= rng << 5;
+            rng as f32 / u32::MAX as f32
+        };
+        for case in 0..20_000 {
+            let mut w = Wavelengths::sample_visible(next());
+            if case % 7 == 0 {
+                w.terminate_secondary();
+            }
+            let l = SampledSpectrum(std::array::from_fn(|_| next() * 4.0));
+            let want = xyz_to_linear_srgb(to_xyz(&l, &w));
+            let got = to_linear_srgb(l.0, w.lambda, w.pdf);
+            let scale = (0..N_LAMBDA)
+                .filter(|&k| w.pdf[k] != 0.0)
+                .map(|k| l.0[k] / w.pdf[k] / (N_LAMBDA as f32 * CIE_Y_INTEGRAL))
+                .fold(0.0f32, f32::max)
+                * 4.0;
+            let err = (got - want).abs().max_element();
+            assert!(err <= 1e-5 * scale + 1e-12, "{w:?} {l:?}: {got} vs {want}");
+        }
+        // Outside the table and terminated wavelengths add nothing.
+        let w = Wavelengths {
+            lambda: [300.0, 900.0, 550.0, f32::NAN],
+            pdf: [1.0, 1.0, 0.0, 1.0],
+        };
+        assert_eq!(to_linear_srgb([1.0; 4], w.lambda, w.pdf), Vec3::ZERO);
+    }
 
     #[test]
     fn srgb_matrices_follow_from_the_primaries() {

@@ -22,7 +22,8 @@ mod sampled;
 
 pub use cie::{
     CIE_Y_INTEGRAL, SRGB_TO_XYZ, XYZ_TO_SRGB, cie_xyz, d65, linear_srgb_to_xyz, luminance,
-    reflectance_to_xyz, spectrum_to_xyz, to_xyz, xyz_to_chromaticity, xyz_to_linear_srgb,
+    reflectance_to_xyz, spectrum_to_xyz, to_linear_srgb, to_xyz, xyz_to_chromaticity,
+    xyz_to_linear_srgb,
 };
 pub use emitter::{Blackbody, EmitterSpectrum, Illuminant, NamedIlluminant, SUN_KELVIN, planck};
 pub use ior::{IorModel, IorPreset};
