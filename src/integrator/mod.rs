@@ -34,6 +34,7 @@ pub mod kernel;
 mod light;
 mod material;
 mod media;
+pub mod microfacet;
 mod roulette;
 mod shadow;
 mod state;
