@@ -634,6 +634,36 @@ fn errors_about_entities_after_parsing_carry_their_position() {
             "(0.0, 0.0, 4.0)),",
             "entity \"camera\": field `look_at`:",
         ),
+        (
+            ball,
+            "material: Conductor(metal: Au, alpha: 1.5)",
+            "1.5)",
+            "entity \"ball\": field `material.alpha`: must be in [0, 1], got 1.5",
+        ),
+        (
+            ball,
+            "material: Conductor(metal: Au, alpha: 0.1, roughness: 0.3)",
+            "0.3)",
+            "entity \"ball\": field `material.roughness`: give `alpha` or `roughness`",
+        ),
+        (
+            ball,
+            "material: Conductor(eta: Rgb(0.2, 0.0, 1.0), k: Rgb(3.0, 2.0, 1.0))",
+            "Rgb(0.2, 0.0",
+            "entity \"ball\": field `material.eta`: every channel must be in (0, 100], got Rgb(0.2, 0, 1)",
+        ),
+        (
+            ball,
+            "material: Conductor(eta: Rgb(0.2, 0.5, 1.0))",
+            "Conductor(",
+            "entity \"ball\": field `material.k`: `eta` needs `k` beside it",
+        ),
+        (
+            ball,
+            "material: Conductor(metal: Au, reflectance: Rgb(1.0, 1.0, 1.0))",
+            "Conductor(",
+            "entity \"ball\": field `material`: a Conductor takes one of",
+        ),
     ];
     for (from, to, marker, says) in cases {
         let text = GOOD.replace(",\n         material", ", material").replace(

@@ -8,13 +8,15 @@
 //! # let _ = m;
 //! let m: Material = ron::from_str("Dielectric(ior: Constant(1.5))").unwrap();
 //! # let _ = m;
+//! let m: Material = ron::from_str("Conductor(metal: Some(Au), alpha: Some(0.2))").unwrap();
+//! # let _ = m;
 //! let m: Material = ron::from_str("Light(emission: Rgb(17.0, 12.0, 4.0), two_sided: false)").unwrap();
 //! # let _ = m;
 //! ```
 //! A `Light` emits from the side its normal faces (spheres and boxes: outward) unless
 //! `two_sided`; it does not scatter.
 
-use crate::spectrum::{EmitterSpectrum, IorModel};
+use crate::spectrum::{EmitterSpectrum, IorModel, Metal};
 use glam::Vec3;
 
 /// How a surface scatters or emits light.
@@ -36,6 +38,14 @@ pub enum Material {
         /// Refractive index of the glass as a function of wavelength.
         ior: IorModel,
     },
+    /// A metal: GGX microfacet reflection with a conductor's Fresnel term; a mirror weighted
+    /// by that term when `alpha` is below [`crate::integrator::microfacet::SMOOTH_ALPHA`].
+    Conductor {
+        /// What the Fresnel term is made of.
+        ior: ConductorIor,
+        /// GGX roughness α (isotropic), in [0, 1].
+        alpha: f32,
+    },
     /// An area emitter of constant radiance: `emission` is its linear sRGB colour, `spectrum`
     /// what spectral transport evaluates.
     Light {
@@ -50,9 +60,44 @@ pub enum Material {
     Boundary,
 }
 
+/// A conductor's Fresnel term.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum ConductorIor {
+    /// A measured metal: its n + ik at each wavelength in spectral transport; in RGB
+    /// transport Schlick's form with its D65 normal-incidence reflectance `r0`
+    /// ([`ConductorIor::metal`] computes it).
+    Metal {
+        /// The metal.
+        metal: Metal,
+        /// Its normal-incidence reflectance under D65, linear sRGB.
+        r0: Vec3,
+    },
+    /// A complex IOR per linear sRGB channel, upsampled to smooth spectra in spectral
+    /// transport.
+    Complex {
+        /// Real part, > 0.
+        eta: Vec3,
+        /// Extinction coefficient, ≥ 0.
+        k: Vec3,
+    },
+    /// Schlick's form with this normal-incidence reflectance (linear sRGB, in [0, 1]).
+    Reflectance(Vec3),
+}
+
+impl ConductorIor {
+    /// A measured metal, with the RGB colour RGB transport uses for it.
+    pub fn metal(metal: Metal) -> Self {
+        ConductorIor::Metal {
+            metal,
+            r0: metal.reflectance_rgb(),
+        }
+    }
+}
+
 impl Material {
     /// The material with its colour multiplied by a texture's albedo: Diffuse albedo, Mirror
-    /// tint, Light emission; a Dielectric has no colour to modulate.
+    /// tint, Light emission, a Conductor's reflectance colour; a Dielectric and a Conductor
+    /// of measured or complex IOR have no colour to modulate.
     #[inline]
     pub fn modulated(self, a: Vec3) -> Material {
         match self {
@@ -67,7 +112,16 @@ impl Material {
                 two_sided,
                 spectrum,
             },
-            m @ (Material::Dielectric { .. } | Material::Boundary) => m,
+            Material::Conductor {
+                ior: ConductorIor::Reflectance(r),
+                alpha,
+            } => Material::Conductor {
+                ior: ConductorIor::Reflectance(r * a),
+                alpha,
+            },
+            m @ (Material::Dielectric { .. } | Material::Boundary | Material::Conductor { .. }) => {
+                m
+            }
         }
     }
 
@@ -148,6 +202,20 @@ impl std::fmt::Display for Material {
                 };
                 write!(f, "Dielectric(ior: {ior})")
             }
+            Material::Conductor { ior, alpha } => {
+                match ior {
+                    ConductorIor::Metal { metal, .. } => {
+                        write!(f, "Conductor(metal: {}", metal.name())?
+                    }
+                    ConductorIor::Complex { eta, k } => {
+                        write!(f, "Conductor(eta: {}, k: {}", Rgb(*eta), Rgb(*k))?
+                    }
+                    ConductorIor::Reflectance(r) => {
+                        write!(f, "Conductor(reflectance: {}", Rgb(*r))?
+                    }
+                }
+                write!(f, ", alpha: {alpha:?})")
+            }
             Material::Light {
                 emission,
                 two_sided,
@@ -225,6 +293,30 @@ mod tests {
                     false,
                 ),
                 "Light(emission: Illuminant(spectrum: D65, scale: 2.0))",
+            ),
+            (
+                Material::Conductor {
+                    ior: ConductorIor::metal(Metal::Au),
+                    alpha: 0.2,
+                },
+                "Conductor(metal: Au, alpha: 0.2)",
+            ),
+            (
+                Material::Conductor {
+                    ior: ConductorIor::Complex {
+                        eta: Vec3::new(0.2, 0.9, 1.1),
+                        k: Vec3::new(3.9, 2.4, 2.2),
+                    },
+                    alpha: 0.0,
+                },
+                "Conductor(eta: Rgb(0.2, 0.9, 1.1), k: Rgb(3.9, 2.4, 2.2), alpha: 0.0)",
+            ),
+            (
+                Material::Conductor {
+                    ior: ConductorIor::Reflectance(Vec3::new(0.9, 0.6, 0.3)),
+                    alpha: 0.5,
+                },
+                "Conductor(reflectance: Rgb(0.9, 0.6, 0.3), alpha: 0.5)",
             ),
         ];
         for (m, want) in cases {

@@ -1,20 +1,23 @@
-//! Light samples: next-event estimation at the diffuse lanes, a light chosen and sampled per
-//! lane, its BSDF value and MIS weight over lanes, then its shadow ray.
+//! Light samples: next-event estimation at the lanes whose BSDF has a density (diffuse and
+//! rough conductors), a light chosen and sampled per lane, its BSDF value and MIS weight over
+//! lanes, then its shadow ray.
 
 use super::RenderStats;
 use super::bsdf::{Chan, Diffuse, Frame};
 use super::ctx::Ctx;
 use super::shadow;
-use super::state::{C, M, MAX_W, Paths, U, gdot, power_heuristic};
+use super::state::{C, M, MAX_W, Paths, U, gdot, power_heuristic, select_c};
 use super::surface::Surface;
 use super::transport::{ChannelArray, Transport};
 use crate::scene::light_lanes::LaneLightSample;
 use crate::scene::lights::LightSource;
 use crate::simd::{Float, Mask, UInt};
 
-/// Next-event estimation at the diffuse lanes `dm`: a light sample per lane, its BSDF value
-/// and MIS weight over lanes, then a shadow ray per lane whose contribution is not zero.
+/// Next-event estimation at the lanes `dm`, diffuse but for the rough conductors `glossy`: a
+/// light sample per lane, its BSDF value and MIS weight over lanes, then a shadow ray per lane
+/// whose contribution is not zero.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 pub(super) fn light_samples<
     F: Float,
     T: Transport<S: ChannelArray<N>>,
@@ -26,6 +29,7 @@ pub(super) fn light_samples<
     st: &mut Paths<F, T, N>,
     sf: &Surface<F, N>,
     dm: M<F>,
+    glossy: M<F>,
     frame: &Frame<F>,
     dim: U<F>,
     stats: &mut RenderStats,
@@ -58,8 +62,13 @@ pub(super) fn light_samples<
         return;
     }
     let bsdf = Diffuse { albedo: sf.color };
-    let bsdf_pdf = bsdf.pdf(wo_l, wi_l);
-    let f = bsdf.eval(wo_l, wi_l) * cos;
+    let mut bsdf_pdf = bsdf.pdf(wo_l, wi_l);
+    let mut f = bsdf.eval(wo_l, wi_l) * cos;
+    if glossy.any() {
+        let c = sf.conductor();
+        bsdf_pdf = F::select(glossy, c.pdf(wo_l, wi_l), bsdf_pdf);
+        f = select_c(glossy, c.eval(wo_l, wi_l) * cos, f);
+    }
     let pdf = ls.pdf;
     let w = F::select(ls.delta, F::one(), power_heuristic(pdf, bsdf_pdf));
     let rad = lane_radiance(ctx, st, &ls, &sources, ok);

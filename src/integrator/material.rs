@@ -1,19 +1,19 @@
 //! Materials: one scattering event per lane, a BSDF sample for each material class present
-//! (a class no lane needs is skipped), light samples at the diffuse lanes, then Russian
-//! roulette.
+//! (a class no lane needs is skipped), light samples at the lanes whose BSDF has a density
+//! (diffuse and rough conductors), then Russian roulette.
 
 use super::bsdf::{Dielectric, Diffuse, Frame, Mirror, Mode};
 use super::ctx::{Ctx, DIM_BOUNCE, DIMS_PER_BOUNCE};
 use super::state::{C, M, MAX_W, Paths, U, gdot, gnormalize, mask_from_bits, select_c};
-use super::surface::{CLASS_DIELECTRIC, CLASS_DIFFUSE, CLASS_MIRROR, Surface};
+use super::surface::{CLASS_CONDUCTOR, CLASS_DIELECTRIC, CLASS_DIFFUSE, CLASS_MIRROR, Surface};
 use super::transport::{ChannelArray, Transport};
 use super::{RenderStats, light, media, roulette};
 use crate::components::Material;
 use crate::geometry::offset_ray_origin_lanes;
 use crate::simd::{Float, Mask, UInt, V3};
 
-/// One scattering event in every lane of `live`: light samples at diffuse lanes, then a BSDF
-/// sample per material class present, then Russian roulette.
+/// One scattering event in every lane of `live`: light samples at diffuse and rough
+/// conductor lanes, then a BSDF sample per material class present, then Russian roulette.
 #[inline(always)]
 pub(super) fn scatter<
     F: Float,
@@ -40,12 +40,20 @@ pub(super) fn scatter<
         class(CLASS_MIRROR),
         class(CLASS_DIELECTRIC),
     );
+    let cm = class(CLASS_CONDUCTOR);
+    // Rough conductors have a density: light sampling evaluates them, as it does diffuse
+    // surfaces. Smooth ones are delta lobes, like mirrors.
+    let conductor = sf.conductor();
+    let glossy = cm.and_not(conductor.smooth);
     let up = offset_ray_origin_lanes(sf.p, sf.nf);
     let mut scattered = M::<F>::splat(false);
+    let nee = dm | glossy;
+    if ctx.nee && nee.any() {
+        light::light_samples::<F, T, N, MOTION, MEDIA>(
+            ctx, st, sf, nee, glossy, &frame, dim, stats,
+        );
+    }
     if dm.any() {
-        if ctx.nee {
-            light::light_samples::<F, T, N, MOTION, MEDIA>(ctx, st, sf, dm, &frame, dim, stats);
-        }
         let (ux, uy) =
             ctx.sampler
                 .get_2d_lanes::<F>(st.pixel, st.sample, dim.wrapping_add(U::<F>::splat(4)));
@@ -59,6 +67,24 @@ pub(super) fn scatter<
         st.specular = st.specular.and_not(ok);
         st.o = V3::select(ok, up, st.o);
         st.d = V3::select(ok, wi, st.d);
+        scattered |= ok;
+    }
+    if cm.any() {
+        let (ux, uy) =
+            ctx.sampler
+                .get_2d_lanes::<F>(st.pixel, st.sample, dim.wrapping_add(U::<F>::splat(4)));
+        let bs = conductor.sample(wo_l, ux, uy);
+        let smooth = cm & conductor.smooth;
+        let wi = frame.to_world(bs.wi).normalize();
+        // A rough reflection about a tilted shading normal can point into the geometric back
+        // side: absorbed, as for diffuse lanes. A smooth one is kept above, as a mirror's.
+        let ok = cm & bs.pdf.gt(F::zero()) & (smooth | gdot(wi, sf.nf).gt(F::zero()));
+        st.alive = st.alive.and_not(cm.and_not(ok));
+        st.beta = select_c(ok, st.beta * bs.weight, st.beta);
+        st.prev_pdf = F::select(ok, bs.pdf, st.prev_pdf);
+        st.specular = st.specular.and_not(ok) | (ok & smooth);
+        st.o = V3::select(ok, up, st.o);
+        st.d = V3::select(ok, V3::select(smooth, reflect_above(wi, sf.nf), wi), st.d);
         scattered |= ok;
     }
     if mm.any() {

@@ -4,6 +4,7 @@
 
 use super::bsdf::LaneChannels;
 use super::ctx::Ctx;
+use super::microfacet::{Conductor, ConductorFresnel, Ggx, SMOOTH_ALPHA};
 use super::state::{C, M, MAX_W, Paths, Scratch3, U, mask_from_bits, power_heuristic};
 use super::transport::{ChannelArray, Transport};
 use crate::components::Material;
@@ -21,6 +22,7 @@ pub(super) const CLASS_MIRROR: u32 = 2;
 pub(super) const CLASS_DIELECTRIC: u32 = 3;
 /// MEDIA: a medium's boundary, crossed without scattering.
 pub(super) const CLASS_BOUNDARY: u32 = 4;
+pub(super) const CLASS_CONDUCTOR: u32 = 5;
 
 /// What the surface stage found at each lane's hit point.
 pub(super) struct Surface<F: Float, const N: usize> {
@@ -31,16 +33,37 @@ pub(super) struct Surface<F: Float, const N: usize> {
     pub(super) nsf: V3<F>,
     pub(super) front: M<F>,
     pub(super) class: U<F>,
-    /// Albedo (Diffuse) or tint (Mirror), texture-modulated.
+    /// Albedo (Diffuse) or tint (Mirror), texture-modulated; a Conductor's η (or Schlick's
+    /// normal-incidence reflectance).
     pub(super) color: C<F, N>,
+    /// A Conductor's GGX α, and the conductor lanes with Schlick's Fresnel form.
+    pub(super) alpha: F,
+    pub(super) schlick: M<F>,
     /// Each lane's material index (for a dielectric's IOR model) and primitive (for the
     /// medium behind a dielectric).
     pub(super) mat: [u32; MAX_W],
     pub(super) prim: [u32; MAX_W],
     /// Lanes that hit an emitter with non-zero radiance, the radiance and its MIS weight.
+    /// A lane is an emitter or a conductor, never both: `le` holds a Conductor's k.
     pub(super) emits: M<F>,
     pub(super) le: C<F, N>,
     pub(super) le_w: F,
+}
+
+impl<F: Float, const N: usize> Surface<F, N> {
+    /// The conductor BSDF of the conductor lanes (meaningless in others).
+    #[inline(always)]
+    pub(super) fn conductor(&self) -> Conductor<F, N> {
+        Conductor {
+            dist: Ggx::isotropic(self.alpha),
+            smooth: self.alpha.lt(F::splat(SMOOTH_ALPHA)),
+            fresnel: ConductorFresnel {
+                eta: self.color,
+                k: self.le,
+                schlick: self.schlick,
+            },
+        }
+    }
 }
 
 /// Where a hit's albedo texture stands after [`surface_material`].
@@ -103,10 +126,15 @@ struct LaneHit {
 /// Per-lane results of the material stage, filled one lane at a time.
 struct Shading<T: Transport> {
     color: T::Colours,
+    /// Emitters' radiance, conductors' k.
     le: T::Colours,
     class: [u32; MAX_W],
     le_w: [f32; MAX_W],
+    alpha: [f32; MAX_W],
     emit_bits: u32,
+    /// Conductor lanes, and those among them with Schlick's Fresnel form.
+    conductor_bits: u32,
+    schlick_bits: u32,
 }
 
 impl<T: Transport> Shading<T> {
@@ -135,6 +163,22 @@ impl<T: Transport> Shading<T> {
                 T::set_reflectance(&mut self.color, i, ctx, h.mat, tint, textured);
             }
             Material::Dielectric { .. } => self.class[i] = CLASS_DIELECTRIC,
+            Material::Conductor { ior, alpha } => {
+                self.class[i] = CLASS_CONDUCTOR;
+                self.alpha[i] = alpha;
+                self.conductor_bits |= 1 << i;
+                let schlick = T::set_conductor(
+                    &mut self.color,
+                    &mut self.le,
+                    i,
+                    ctx,
+                    h.mat,
+                    &ior,
+                    textured,
+                    &st.lam,
+                );
+                self.schlick_bits |= u32::from(schlick) << i;
+            }
             Material::Light { .. } => {
                 let radiance = emitted(&material, h.n, -st.d.lane(i));
                 if radiance != Vec3::ZERO {
@@ -186,7 +230,10 @@ pub(super) fn surfaces<
         le: T::colours(),
         class: [CLASS_NONE; MAX_W],
         le_w: [0.0; MAX_W],
+        alpha: [0.0; MAX_W],
         emit_bits: 0,
+        conductor_bits: 0,
+        schlick_bits: 0,
     };
     let mut mats = [0u32; MAX_W];
     let mut prim = [0u32; MAX_W];
@@ -275,10 +322,12 @@ pub(super) fn surfaces<
         front: mask_from_bits::<F>(front_bits),
         class: U::<F>::from_fn(|i| shade.class[i]),
         color: T::eval(&shade.color, &st.lam),
+        alpha: F::load(&shade.alpha),
+        schlick: mask_from_bits::<F>(shade.schlick_bits),
         mat: mats,
         prim,
         emits: mask_from_bits::<F>(shade.emit_bits),
-        le: if shade.emit_bits != 0 {
+        le: if shade.emit_bits | shade.conductor_bits != 0 {
             T::eval(&shade.le, &st.lam)
         } else {
             C::<F, N>::splat(F::zero())

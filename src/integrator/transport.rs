@@ -11,6 +11,7 @@
 use super::bsdf::Chan;
 use super::ctx::Ctx;
 use super::state::{MAX_W, mask_from_bits};
+use crate::components::ConductorIor;
 use crate::medium::{HomogeneousMedium, lanes};
 use crate::scene::lights::{LightSample, LightSource};
 use crate::scene::{LightKind, RenderScene};
@@ -162,6 +163,9 @@ pub struct SpectralData {
     environment: Option<EmitSpec>,
     /// Per medium: σa, σs as smooth unbounded spectra, and g.
     media: Vec<(RgbUnbounded, RgbUnbounded, f32)>,
+    /// Per material: a conductor's complex IOR η and k as smooth unbounded spectra (zero
+    /// for other materials).
+    conductor: Vec<(RgbUnbounded, RgbUnbounded)>,
 }
 
 impl SpectralData {
@@ -172,6 +176,7 @@ impl SpectralData {
         point: Vec::new(),
         environment: None,
         media: Vec::new(),
+        conductor: Vec::new(),
     };
 
     /// The spectral forms of every material, point light, medium and the environment of `scene`.
@@ -184,6 +189,10 @@ impl SpectralData {
             .map(|m| match *m {
                 Material::Diffuse { albedo } => RgbSigmoid::from_rgb(albedo),
                 Material::Mirror { tint } => RgbSigmoid::from_rgb(tint),
+                Material::Conductor {
+                    ior: ConductorIor::Reflectance(r),
+                    ..
+                } => RgbSigmoid::from_rgb(r),
                 _ => RgbSigmoid::grey(0.0),
             })
             .collect();
@@ -217,10 +226,25 @@ impl SpectralData {
                 )
             })
             .collect();
+        let conductor = prims
+            .materials
+            .iter()
+            .map(|m| match *m {
+                Material::Conductor {
+                    ior: ConductorIor::Complex { eta, k },
+                    ..
+                } => (RgbUnbounded::from_rgb(eta), RgbUnbounded::from_rgb(k)),
+                _ => (
+                    RgbUnbounded::from_rgb(Vec3::ZERO),
+                    RgbUnbounded::from_rgb(Vec3::ZERO),
+                ),
+            })
+            .collect();
         SpectralData {
             refl,
             emit,
             point,
+            conductor,
             environment: Some(EmitSpec::new(scene.environment, scene.environment_spectrum)),
             media,
         }
@@ -309,6 +333,20 @@ pub trait Transport: Copy + Send + Sync + 'static {
         rgb: Vec3,
         textured: bool,
     );
+    /// Lane `i`: the Fresnel inputs of conductor `mat` described by `ior` (texture-modulated
+    /// when `textured`): η, or Schlick's normal-incidence reflectance, into `eta`, and k into
+    /// `k`. Returns whether the lane takes Schlick's form.
+    #[allow(clippy::too_many_arguments)]
+    fn set_conductor<F: Float>(
+        eta: &mut Self::Colours,
+        k: &mut Self::Colours,
+        i: usize,
+        ctx: &Ctx,
+        mat: u32,
+        ior: &ConductorIor,
+        textured: bool,
+        lam: &Self::Lanes<F>,
+    ) -> bool;
     /// Lane `i`: radiance `le` (RGB, already texture-modulated by `tex`) of emitter `mat`.
     #[allow(clippy::too_many_arguments)]
     fn set_emission<F: Float>(
@@ -420,6 +458,33 @@ impl Transport for Rgb {
         c.set(i, rgb);
     }
     #[inline(always)]
+    fn set_conductor<F: Float>(
+        eta: &mut RgbColours,
+        k: &mut RgbColours,
+        i: usize,
+        _: &Ctx,
+        _: u32,
+        ior: &ConductorIor,
+        _: bool,
+        _: &(),
+    ) -> bool {
+        match *ior {
+            ConductorIor::Metal { r0, .. } => {
+                eta.set(i, r0);
+                true
+            }
+            ConductorIor::Complex { eta: e, k: kk } => {
+                eta.set(i, e);
+                k.set(i, kk);
+                false
+            }
+            ConductorIor::Reflectance(r) => {
+                eta.set(i, r);
+                true
+            }
+        }
+    }
+    #[inline(always)]
     fn set_emission<F: Float>(
         c: &mut RgbColours,
         i: usize,
@@ -508,6 +573,24 @@ impl SpectralColours {
         let c = s.coeffs();
         (self.c[0][i], self.c[1][i], self.c[2][i]) = (c[0], c[1], c[2]);
         self.s1[i] = s.scale();
+    }
+
+    /// Lane `i` is the unbounded spectrum `u` (a conductor's η or k).
+    #[inline(always)]
+    fn unbounded(&mut self, i: usize, u: &RgbUnbounded) {
+        self.sigmoid(i, &u.shape());
+        self.s2[i] = u.scale();
+    }
+
+    /// Lane `i` takes the values `v` at its wavelengths (a measured metal's n or k, looked up
+    /// for the lane when it is set, as a physically defined emitter is).
+    #[inline(always)]
+    fn tabulated(&mut self, i: usize, v: [f32; N_LAMBDA]) {
+        self.sigmoid(i, &RgbSigmoid::grey(1.0));
+        for (p, v) in self.p.iter_mut().zip(v) {
+            p[i] = v;
+        }
+        self.phys |= 1 << i;
     }
 
     /// Lane `i` emits `spec` (times the reflectance `tint`, a texture's, if any) times `k`.
@@ -632,6 +715,41 @@ impl Transport for Spectral {
             c.sigmoid(i, &RgbSigmoid::from_rgb(rgb));
         } else {
             c.sigmoid(i, &ctx.spectral.refl[mat as usize]);
+        }
+    }
+    #[inline(always)]
+    fn set_conductor<F: Float>(
+        eta: &mut SpectralColours,
+        k: &mut SpectralColours,
+        i: usize,
+        ctx: &Ctx,
+        mat: u32,
+        ior: &ConductorIor,
+        textured: bool,
+        lam: &LaneWavelengths<F>,
+    ) -> bool {
+        match *ior {
+            ConductorIor::Metal { metal, .. } => {
+                let l = lam.lane(i).lambda;
+                let nk = l.map(|l| metal.nk(l));
+                eta.tabulated(i, nk.map(|v| v.0));
+                k.tabulated(i, nk.map(|v| v.1));
+                false
+            }
+            ConductorIor::Complex { .. } => {
+                let (e, kk) = &ctx.spectral.conductor[mat as usize];
+                eta.unbounded(i, e);
+                k.unbounded(i, kk);
+                false
+            }
+            ConductorIor::Reflectance(r) => {
+                if textured {
+                    eta.sigmoid(i, &RgbSigmoid::from_rgb(r));
+                } else {
+                    eta.sigmoid(i, &ctx.spectral.refl[mat as usize]);
+                }
+                true
+            }
         }
     }
     #[inline(always)]

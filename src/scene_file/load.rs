@@ -597,7 +597,8 @@ fn build_world(
             None => {
                 return Err(err(
                     "material",
-                    "a shape needs a material (Diffuse, Mirror, Dielectric or Light)".into(),
+                    "a shape needs a material (Diffuse, Mirror, Conductor, Dielectric or Light)"
+                        .into(),
                 ));
             }
             Some(schema::Material::Diffuse { albedo }) => Material::Diffuse {
@@ -605,6 +606,15 @@ fn build_world(
             },
             Some(schema::Material::Mirror { tint }) => Material::Mirror { tint: tint.0.vec() },
             Some(schema::Material::Dielectric { ior }) => Material::Dielectric { ior: ior.0 },
+            Some(schema::Material::Conductor {
+                metal,
+                eta,
+                k,
+                reflectance,
+                alpha,
+                roughness,
+            }) => conductor(*metal, *eta, *k, *reflectance, *alpha, *roughness)
+                .map_err(|(field, m)| err(field, m))?,
             Some(schema::Material::Light {
                 emission,
                 two_sided,
@@ -629,7 +639,10 @@ fn build_world(
         if medium.is_some()
             && matches!(
                 material,
-                Material::Mirror { .. } | Material::Light { .. } | Material::Diffuse { .. }
+                Material::Mirror { .. }
+                    | Material::Light { .. }
+                    | Material::Diffuse { .. }
+                    | Material::Conductor { .. }
             )
         {
             return Err(err(
@@ -686,4 +699,88 @@ fn build_world(
         environment_spectrum,
         hash,
     })
+}
+
+/// A `Conductor` from its scene fields: exactly one source of its Fresnel term, at most one
+/// of `alpha` and `roughness`, each value in its range. An error names the field it is about.
+fn conductor(
+    metal: Option<schema::MetalName>,
+    eta: Option<schema::Color>,
+    k: Option<schema::Color>,
+    reflectance: Option<schema::Albedo>,
+    alpha: Option<f32>,
+    roughness: Option<f32>,
+) -> Result<Material, (&'static str, String)> {
+    use crate::components::ConductorIor;
+    let complex = |c: schema::Color, field: &'static str, lo_open: bool| {
+        let v = c.vec();
+        let ok = v.is_finite()
+            && v.max_element() <= 100.0
+            && if lo_open {
+                v.min_element() > 0.0
+            } else {
+                v.min_element() >= 0.0
+            };
+        if ok {
+            Ok(v)
+        } else {
+            let range = if lo_open { "(0, 100]" } else { "[0, 100]" };
+            Err((
+                field,
+                format!(
+                    "every channel must be in {range}, got Rgb({}, {}, {})",
+                    v.x, v.y, v.z
+                ),
+            ))
+        }
+    };
+    let ior = match (metal, eta, k, reflectance) {
+        (Some(m), None, None, None) => ConductorIor::metal(m.metal()),
+        (None, Some(eta), Some(k), None) => ConductorIor::Complex {
+            eta: complex(eta, "material.eta", true)?,
+            k: complex(k, "material.k", false)?,
+        },
+        (None, None, None, Some(r)) => ConductorIor::Reflectance(r.0.vec()),
+        (None, Some(_), None, None) => {
+            return Err(("material.k", "`eta` needs `k` beside it".into()));
+        }
+        (None, None, Some(_), None) => {
+            return Err(("material.eta", "`k` needs `eta` beside it".into()));
+        }
+        (None, None, None, None) => {
+            return Err((
+                "material",
+                "a Conductor needs `metal`, `eta` with `k`, or `reflectance`".into(),
+            ));
+        }
+        _ => {
+            return Err((
+                "material",
+                "a Conductor takes one of `metal`, `eta` with `k`, or `reflectance`, not several"
+                    .into(),
+            ));
+        }
+    };
+    let unit = |v: f32, field: &'static str| {
+        if (0.0..=1.0).contains(&v) {
+            Ok(v)
+        } else {
+            Err((field, format!("must be in [0, 1], got {v}")))
+        }
+    };
+    let alpha = match (alpha, roughness) {
+        (Some(_), Some(_)) => {
+            return Err((
+                "material.roughness",
+                "give `alpha` or `roughness` (α = roughness²), not both".into(),
+            ));
+        }
+        (Some(a), None) => unit(a, "material.alpha")?,
+        (None, Some(r)) => {
+            let r = unit(r, "material.roughness")?;
+            r * r
+        }
+        (None, None) => 0.0,
+    };
+    Ok(Material::Conductor { ior, alpha })
 }

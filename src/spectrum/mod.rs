@@ -17,6 +17,8 @@ mod cie_data;
 mod emitter;
 mod ior;
 pub mod lanes;
+mod metals;
+mod metals_data;
 pub mod rgb2spec;
 mod sampled;
 
@@ -27,6 +29,7 @@ pub use cie::{
 };
 pub use emitter::{Blackbody, EmitterSpectrum, Illuminant, NamedIlluminant, SUN_KELVIN, planck};
 pub use ior::{IorModel, IorPreset};
+pub use metals::Metal;
 pub use rgb2spec::{RgbIlluminant, RgbSigmoid, RgbUnbounded};
 pub use sampled::{Channels, SampledSpectrum, Wavelengths, sample_visible_wavelength};
 

@@ -343,6 +343,16 @@ impl RgbUnbounded {
         self.scale * self.shape.eval(lambda)
     }
 
+    /// The bounded spectrum this one is a multiple of.
+    pub fn shape(&self) -> RgbSigmoid {
+        self.shape
+    }
+
+    /// The factor on [`RgbUnbounded::shape`]: 2·max(rgb).
+    pub fn scale(&self) -> f32 {
+        self.scale
+    }
+
     /// [`RgbUnbounded::eval`] at four wavelengths.
     #[inline(always)]
     pub fn eval4(&self, lambda: [f32; 4]) -> [f32; 4] {

@@ -21,6 +21,29 @@ pub enum Material {
         /// Index of refraction inside the surface; outside it is 1.
         ior: Ior,
     },
+    /// A metal: GGX microfacet reflection (smooth below α = 0.001) with a conductor's Fresnel
+    /// term. Exactly one of `metal`, `eta` with `k`, or `reflectance`; at most one of `alpha`
+    /// and `roughness` (neither: a polished, smooth surface).
+    Conductor {
+        /// A measured metal: `Au`, `Ag`, `Cu`, `Al`, `Cr`, `Ti`, `Ni` or `Pt`.
+        #[serde(default)]
+        metal: Option<MetalName>,
+        /// The real part of the complex IOR per channel, each in (0, 100].
+        #[serde(default)]
+        eta: Option<Color>,
+        /// The extinction coefficient per channel, each in [0, 100].
+        #[serde(default)]
+        k: Option<Color>,
+        /// An artist's normal-incidence reflectance (Schlick's form), every channel in [0, 1].
+        #[serde(default)]
+        reflectance: Option<Albedo>,
+        /// GGX α in [0, 1] (as Mitsuba's `alpha`).
+        #[serde(default)]
+        alpha: Option<f32>,
+        /// Perceptual roughness r in [0, 1] (glTF, Blender): α = r².
+        #[serde(default)]
+        roughness: Option<f32>,
+    },
     /// An area light on a Sphere, Rect or Disk; it emits and does not scatter.
     Light {
         /// Emitted radiance.
@@ -30,6 +53,44 @@ pub enum Material {
         #[serde(default)]
         two_sided: bool,
     },
+}
+
+/// A measured metal, by its chemical symbol.
+#[derive(Clone, Copy, Debug, Deserialize)]
+pub enum MetalName {
+    /// Gold.
+    Au,
+    /// Silver.
+    Ag,
+    /// Copper.
+    Cu,
+    /// Aluminium.
+    Al,
+    /// Chromium.
+    Cr,
+    /// Titanium.
+    Ti,
+    /// Nickel.
+    Ni,
+    /// Platinum.
+    Pt,
+}
+
+impl MetalName {
+    /// The metal's tables.
+    pub fn metal(self) -> crate::spectrum::Metal {
+        use crate::spectrum::Metal;
+        match self {
+            MetalName::Au => Metal::Au,
+            MetalName::Ag => Metal::Ag,
+            MetalName::Cu => Metal::Cu,
+            MetalName::Al => Metal::Al,
+            MetalName::Cr => Metal::Cr,
+            MetalName::Ti => Metal::Ti,
+            MetalName::Ni => Metal::Ni,
+            MetalName::Pt => Metal::Pt,
+        }
+    }
 }
 
 /// Index of refraction: `Constant(n)`, `Cauchy(a:, b:)` (λ in µm), `Sellmeier(b:, c:)` (c in
