@@ -3,7 +3,12 @@
 (the view rays parallel to 1/400, so the sphere's points are seen at cosines distributed as
 2μ dμ) in a white constant environment, RGB mode, box pixel filter. Each material's mean
 radiance over the sphere's disc is printed for both renderers with their ratio; the script
-exits 1 if a channel differs by more than the tolerance (2 %).
+exits 1 if a channel of a gated case differs by more than the tolerance (2 %).
+
+Mitsuba's rough conductor uses the separable Smith term G1(wo)·G1(wi), prism the
+height-correlated G2, which is larger: by quadrature of the white-furnace albedo, 0.5 % more
+energy at α = 0.3 and 5.0 % more at α = 0.8. The α = 0.8 case is printed to show that, not
+gated.
 
 The disc's mean comes from the image mean (the pixel filter is a partition of unity, so the
 image mean is the area mean of the radiance) and the disc's analytic share of the image.
@@ -21,11 +26,11 @@ from pathlib import Path
 
 DIST, FOV, SIZE, SPP = 400.0, 0.35, 64, 256
 
-# (name, prism material, Mitsuba BSDF dict)
+# (name, prism material, Mitsuba BSDF dict, gated)
 CASES = [
     (
         "rough conductor, complex IOR, α 0.3",
-        "Conductor(eta: Rgb(0.2, 0.92, 1.1), k: Rgb(3.9, 2.45, 2.14), alpha: 0.3)",
+        "Conductor(eta: Rgb(0.2, 0.92, 1.1), k: Rgb(3.9, 2.45, 2.14), alpha: 0.3, multiscatter: false)",
         {
             "type": "roughconductor",
             "distribution": "ggx",
@@ -34,10 +39,11 @@ CASES = [
             "eta": {"type": "rgb", "value": [0.2, 0.92, 1.1]},
             "k": {"type": "rgb", "value": [3.9, 2.45, 2.14]},
         },
+        True,
     ),
     (
-        "rough conductor, complex IOR, α 0.8",
-        "Conductor(eta: Rgb(1.6, 1.2, 0.9), k: Rgb(2.1, 2.6, 3.3), alpha: 0.8)",
+        "rough conductor, complex IOR, α 0.8 (separable G in Mitsuba)",
+        "Conductor(eta: Rgb(1.6, 1.2, 0.9), k: Rgb(2.1, 2.6, 3.3), alpha: 0.8, multiscatter: false)",
         {
             "type": "roughconductor",
             "distribution": "ggx",
@@ -46,6 +52,7 @@ CASES = [
             "eta": {"type": "rgb", "value": [1.6, 1.2, 0.9]},
             "k": {"type": "rgb", "value": [2.1, 2.6, 3.3]},
         },
+        False,
     ),
     (
         "smooth conductor, complex IOR",
@@ -55,6 +62,7 @@ CASES = [
             "eta": {"type": "rgb", "value": [0.2, 0.92, 1.1]},
             "k": {"type": "rgb", "value": [3.9, 2.45, 2.14]},
         },
+        True,
     ),
 ]
 
@@ -133,11 +141,12 @@ def main():
     print(f"| material | prism (R, G, B) | Mitsuba {mi.__version__} (R, G, B) | largest difference |")
     print("|---|---|---|---|")
     with tempfile.TemporaryDirectory() as d:
-        for name, prism_material, bsdf in CASES:
+        for name, prism_material, bsdf, gated in CASES:
             p = prism_mean(args.prism, prism_material, Path(d))
             m = mitsuba_mean(bsdf)
             diff = max(abs(a / b - 1.0) for a, b in zip(p, m))
-            worst = max(worst, diff)
+            if gated:
+                worst = max(worst, diff)
             fmt = lambda v: ", ".join(f"{x:.4f}" for x in v)
             print(f"| {name} | {fmt(p)} | {fmt(m)} | {100 * diff:.2f} % |")
     if worst > args.tolerance:

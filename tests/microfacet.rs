@@ -7,7 +7,8 @@ use common::chi2::Chi2;
 use glam::{DVec2, Vec3};
 use prism::integrator::bsdf::{Chan, lobe};
 use prism::integrator::microfacet::{
-    Conductor, ConductorFresnel, Ggx, fresnel_conductor, fresnel_schlick_r0,
+    Conductor, ConductorFresnel, Ggx, fresnel_conductor, fresnel_schlick_r0, ggx_albedo,
+    ggx_albedo_lanes, ggx_average_albedo, ggx_average_albedo_lanes,
 };
 use prism::simd::{self, Float, LaneKernel, Lanes, Mask, V3};
 
@@ -16,9 +17,14 @@ mod splitmix;
 use splitmix::SplitMix;
 
 fn gold_like(ax: f32, ay: f32, smooth: bool) -> Conductor<f32, 3> {
+    with_ms(ax, ay, smooth, false)
+}
+
+fn with_ms(ax: f32, ay: f32, smooth: bool, multiscatter: bool) -> Conductor<f32, 3> {
     Conductor {
         dist: Ggx { ax, ay },
         smooth,
+        multiscatter,
         fresnel: ConductorFresnel {
             eta: Chan([0.18, 0.42, 1.37]),
             k: Chan([3.42, 2.35, 1.77]),
@@ -64,6 +70,61 @@ fn visible_normal_sampling_follows_its_pdf() {
                 panic!("α = ({ax}, {ay}), θ = {theta}°: {e}");
             }
         }
+    }
+}
+
+/// With compensation the sampler draws a mixture of the visible normals and a cosine lobe;
+/// it follows `pdf`, and each sample's weight is f·cos/pdf of the compensated f.
+#[test]
+fn compensated_sampling_follows_its_pdf_and_weight() {
+    let cases = [(0.3, 0.0), (0.3, 70.0), (1.0, 30.0), (0.6, 85.0)];
+    for (k, &(alpha, theta)) in cases.iter().enumerate() {
+        let c = with_ms(alpha, alpha, false, true);
+        let wo = incident(theta);
+        let sample = |u: glam::Vec2| {
+            let s = c.sample(wo, u.x, u.y);
+            (s.pdf > 0.0).then(|| Vec3::from(s.wi))
+        };
+        let pdf = |w: Vec3| c.pdf(wo, w.into());
+        if let Err(e) = Chi2::new(300_000, 40 + k as u64)
+            .tests(cases.len())
+            .directions([0.0, 1.0], sample, pdf)
+        {
+            panic!("α = {alpha}, θ = {theta}°: {e}");
+        }
+        let mut g = SplitMix(50 + k as u64);
+        for _ in 0..5000 {
+            let s = c.sample(wo, g.range(0.0, 1.0) as f32, g.range(0.0, 1.0) as f32);
+            if s.pdf == 0.0 {
+                continue;
+            }
+            assert!((s.pdf - c.pdf(wo, s.wi)).abs() <= 1e-4 * s.pdf);
+            let f = c.eval(wo, s.wi);
+            for ch in 0..3 {
+                let w = f.0[ch] * s.wi.z / s.pdf;
+                assert!((w - s.weight.0[ch]).abs() <= 1e-4 * w.max(1e-3));
+            }
+        }
+    }
+}
+
+/// The committed energy tables are what the quadrature gives (a few entries recomputed).
+#[test]
+fn energy_tables_match_the_quadrature() {
+    for (i, j) in [(0, 5), (3, 3), (10, 20), (31, 31), (16, 9), (25, 28)] {
+        let (mu, alpha) = (i as f32 / 31.0, j as f32 / 31.0);
+        let want = ggx_albedo(f64::from(mu), f64::from(alpha)).min(1.0);
+        let got = f64::from(ggx_albedo_lanes(mu, alpha));
+        assert!(
+            (got - want).abs() < 2e-6,
+            "E({mu}, {alpha}): {got} vs {want}"
+        );
+    }
+    for j in [4, 17, 31] {
+        let alpha = j as f32 / 31.0;
+        let want = ggx_average_albedo(f64::from(alpha));
+        let got = f64::from(ggx_average_albedo_lanes(alpha));
+        assert!((got - want).abs() < 2e-6, "E_avg({alpha}): {got} vs {want}");
     }
 }
 
@@ -256,10 +317,17 @@ impl LaneKernel for Conductors<'_> {
             let (u1, u2) = (F::from_fn(|l| at(l).2[0]), F::from_fn(|l| at(l).2[1]));
             let (ax, ay) = (F::from_fn(|l| at(l).3[0]), F::from_fn(|l| at(l).3[1]));
             let mut vals: Vec<F> = Vec::new();
-            for (schlick, smooth) in [(false, false), (true, false), (false, true)] {
+            for (schlick, smooth, ms) in [
+                (false, false, false),
+                (true, false, false),
+                (false, true, false),
+                (false, false, true),
+                (true, true, true),
+            ] {
                 let cd = Conductor {
                     dist: Ggx { ax, ay },
                     smooth: F::Mask::splat(smooth),
+                    multiscatter: F::Mask::splat(ms),
                     fresnel: ConductorFresnel {
                         eta: Chan([0.18, 0.42, 0.9].map(F::splat)),
                         k: Chan([3.42, 2.35, 1.77].map(F::splat)),

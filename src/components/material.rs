@@ -45,6 +45,8 @@ pub enum Material {
         ior: ConductorIor,
         /// GGX roughness α (isotropic), in [0, 1].
         alpha: f32,
+        /// Restore the energy of light scattered among microfacets (Kulla & Conty 2017).
+        multiscatter: bool,
     },
     /// An area emitter of constant radiance: `emission` is its linear sRGB colour, `spectrum`
     /// what spectral transport evaluates.
@@ -115,9 +117,11 @@ impl Material {
             Material::Conductor {
                 ior: ConductorIor::Reflectance(r),
                 alpha,
+                multiscatter,
             } => Material::Conductor {
                 ior: ConductorIor::Reflectance(r * a),
                 alpha,
+                multiscatter,
             },
             m @ (Material::Dielectric { .. } | Material::Boundary | Material::Conductor { .. }) => {
                 m
@@ -202,7 +206,11 @@ impl std::fmt::Display for Material {
                 };
                 write!(f, "Dielectric(ior: {ior})")
             }
-            Material::Conductor { ior, alpha } => {
+            Material::Conductor {
+                ior,
+                alpha,
+                multiscatter,
+            } => {
                 match ior {
                     ConductorIor::Metal { metal, .. } => {
                         write!(f, "Conductor(metal: {}", metal.name())?
@@ -214,7 +222,11 @@ impl std::fmt::Display for Material {
                         write!(f, "Conductor(reflectance: {}", Rgb(*r))?
                     }
                 }
-                write!(f, ", alpha: {alpha:?})")
+                write!(f, ", alpha: {alpha:?}")?;
+                if !multiscatter {
+                    f.write_str(", multiscatter: false")?;
+                }
+                f.write_str(")")
             }
             Material::Light {
                 emission,
@@ -298,6 +310,7 @@ mod tests {
                 Material::Conductor {
                     ior: ConductorIor::metal(Metal::Au),
                     alpha: 0.2,
+                    multiscatter: true,
                 },
                 "Conductor(metal: Au, alpha: 0.2)",
             ),
@@ -308,6 +321,7 @@ mod tests {
                         k: Vec3::new(3.9, 2.4, 2.2),
                     },
                     alpha: 0.0,
+                    multiscatter: true,
                 },
                 "Conductor(eta: Rgb(0.2, 0.9, 1.1), k: Rgb(3.9, 2.4, 2.2), alpha: 0.0)",
             ),
@@ -315,8 +329,9 @@ mod tests {
                 Material::Conductor {
                     ior: ConductorIor::Reflectance(Vec3::new(0.9, 0.6, 0.3)),
                     alpha: 0.5,
+                    multiscatter: false,
                 },
-                "Conductor(reflectance: Rgb(0.9, 0.6, 0.3), alpha: 0.5)",
+                "Conductor(reflectance: Rgb(0.9, 0.6, 0.3), alpha: 0.5, multiscatter: false)",
             ),
         ];
         for (m, want) in cases {

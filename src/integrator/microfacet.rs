@@ -13,8 +13,17 @@
 //!
 //! These forms divide only by sums that vanish when both directions are grazing, where the
 //! callers have already rejected the sample.
+//!
+//! Single scattering loses the energy of light that meets a second microfacet (41 % survives
+//! at α = 1). Kulla & Conty 2017 restore it with a diffuse-like lobe
+//! f_ms = F_ms·(1 − E(μo))(1 − E(μi)) / (π(1 − E_avg)), E(μ) the single-scattering albedo
+//! with F = 1, E_avg = 2∫E(μ)μ dμ, and F_ms = F_avg²·E_avg / (1 − F_avg(1 − E_avg)) the
+//! Fresnel term of the light that bounces on, F_avg = 2∫F(μ)μ dμ: a white conductor then
+//! reflects all the light at every roughness. E and E_avg come from tables this module's
+//! quadrature generates (`examples/ggx_tables.rs`, committed in `ggx_tables.rs`).
 
 use super::bsdf::{BsdfSample, Chan, lobe, reflect_local};
+use super::ggx_tables::{GGX_E, GGX_E_AVG, GGX_TABLE_SIZE};
 use crate::simd::{Float, Mask, UInt, V3, math};
 use std::f32::consts::TAU;
 
@@ -50,6 +59,12 @@ impl<F: Float> Ggx<F> {
         let t = x * x + y * y + h.z * h.z;
         let v = (F::splat(std::f32::consts::PI) * self.ax * self.ay * t * t).recip();
         F::select(h.z.gt(F::zero()), v, F::zero())
+    }
+
+    /// The isotropic α of the same roughness, √(αx·αy): what the energy tables take.
+    #[inline(always)]
+    pub fn alpha(&self) -> F {
+        (self.ax * self.ay).sqrt()
     }
 
     /// s(w): the length of `w` stretched by α, which every Smith term is made of.
@@ -171,37 +186,80 @@ pub struct Conductor<F: Float, const N: usize> {
     pub dist: Ggx<F>,
     /// Lanes whose surface is smooth: a delta lobe.
     pub smooth: F::Mask,
+    /// Rough lanes with multiple-scattering compensation (ignored in smooth lanes).
+    pub multiscatter: F::Mask,
     /// The Fresnel term.
     pub fresnel: ConductorFresnel<F, N>,
 }
 
 impl<F: Float, const N: usize> Conductor<F, N> {
-    /// A visible normal, and `wo` reflected about it; in smooth lanes the mirror direction.
+    /// The lanes whose multiple-scattering lobe is on.
+    #[inline(always)]
+    fn ms_lanes(&self) -> F::Mask {
+        self.multiscatter.and_not(self.smooth)
+    }
+
+    /// The probability of sampling the multiple-scattering lobe from `wo`: the share of the
+    /// energy it adds, 1 − E(μo); zero where compensation is off.
+    #[inline(always)]
+    fn ms_probability(&self, wo: V3<F>, ms: F::Mask) -> F {
+        let e = ggx_albedo_lanes(wo.z, self.dist.alpha());
+        F::select(ms, F::one() - e, F::zero())
+    }
+
+    /// A visible normal, and `wo` reflected about it; in smooth lanes the mirror direction;
+    /// with compensation, with probability 1 − E(μo) a cosine-distributed direction instead.
     /// Lanes where `wo` or the reflection lies below the surface have weight 0 (pdf 0).
     #[inline(always)]
     pub fn sample(&self, wo: V3<F>, u1: F, u2: F) -> BsdfSample<F, Chan<F, N>> {
         let zero = F::zero();
+        let ms = self.ms_lanes();
+        let any_ms = ms.any();
+        // The lobe choice reuses u1, rescaled to [0, 1) within the chosen lobe.
+        let (p_ms, diffuse, u1) = if any_ms {
+            let p = self.ms_probability(wo, ms);
+            let d = ms & u1.lt(p);
+            let u = F::select(d, u1 / p, (u1 - p) / (F::one() - p));
+            (p, d, F::select(ms, u.min(F::splat(ONE_MINUS_EPS)), u1))
+        } else {
+            (zero, F::Mask::splat(false), u1)
+        };
         let h = self.dist.sample_visible_normal(wo, u1, u2);
         let cos_h = wo.dot(h);
         let rough_wi = h * (F::splat(2.0) * cos_h) - wo;
-        let wi = V3::select(self.smooth, reflect_local(wo), rough_wi);
+        let mut wi = V3::select(self.smooth, reflect_local(wo), rough_wi);
+        if any_ms {
+            let c = crate::sampling::warp::lanes::square_to_cosine_hemisphere(u1, u2);
+            wi = V3::select(diffuse, c, wi);
+        }
+        let (zo, zi) = (wo.z, wi.z);
+        let ok = zo.gt(zero) & zi.gt(zero);
         let cos_f = F::select(self.smooth, wo.z, cos_h);
         let fr = self.fresnel.eval(cos_f);
         let so = self.dist.stretched_len(wo);
         let si = self.dist.stretched_len(wi);
-        let (zo, zi) = (wo.z, wi.z);
-        let ok = zo.gt(zero) & zi.gt(zero);
         // F·G2/G1(wo), and the visible-normal pdf D(h)/(2(zo + s(wo))).
         let g = F::select(self.smooth, F::one(), zi * (zo + so) / (so * zi + si * zo));
-        let pdf = F::select(
+        let mut pdf = F::select(
             self.smooth,
             F::one(),
             self.dist.d(h) / (F::splat(2.0) * (zo + so)),
         );
-        let w = F::select(ok, g, zero);
+        let mut weight = fr * F::select(ok, g, zero);
+        if any_ms {
+            // The mixture's weight f·cos/pdf from eval and pdf, in the compensated lanes only,
+            // so a lane's numbers do not depend on its neighbours.
+            let mixture = self.pdf_with(wo, wi, ms, p_ms);
+            let w = F::select(ok & mixture.gt(zero), zi / mixture, zero);
+            let f = self.eval(wo, wi) * w;
+            for (c, m) in weight.0.iter_mut().zip(f.0) {
+                *c = F::select(ms, m, *c);
+            }
+            pdf = F::select(ms, mixture, pdf);
+        }
         BsdfSample {
             wi,
-            weight: fr * w,
+            weight,
             pdf: F::select(ok, pdf, zero),
             lobe: F::U32::select(
                 self.smooth,
@@ -223,16 +281,167 @@ impl<F: Float, const N: usize> Conductor<F, N> {
         let so = self.dist.stretched_len(wo);
         let si = self.dist.stretched_len(wi);
         let v = d / (F::splat(2.0) * (so * zi + si * zo));
-        self.fresnel.eval(wo.dot(h)) * F::select(ok, v, zero)
+        let single = self.fresnel.eval(wo.dot(h)) * F::select(ok, v, zero);
+        let ms = self.ms_lanes() & ok;
+        if ms.none() {
+            return single;
+        }
+        // f_ms = F_ms (1 − E(μo))(1 − E(μi)) / (π (1 − E_avg)).
+        let a = self.dist.alpha();
+        let (eo, ei) = (ggx_albedo_lanes(zo, a), ggx_albedo_lanes(zi, a));
+        let e_avg = ggx_average_albedo_lanes(a);
+        let lobe = (F::one() - eo) * (F::one() - ei)
+            / (F::splat(std::f32::consts::PI) * (F::one() - e_avg).max(F::splat(1e-6)));
+        let f_avg = self.fresnel_average();
+        let mut out = single;
+        for (o, fa) in out.0.iter_mut().zip(f_avg.0) {
+            let f_ms = fa * fa * e_avg / (F::one() - fa * (F::one() - e_avg));
+            *o = F::select(ms, *o + f_ms * lobe, *o);
+        }
+        out
     }
 
     /// The solid-angle density of [`Conductor::sample`] drawing `wi`; zero in smooth lanes.
     #[inline(always)]
     pub fn pdf(&self, wo: V3<F>, wi: V3<F>) -> F {
+        let ms = self.ms_lanes();
+        if ms.none() {
+            return self.pdf_with(wo, wi, ms, F::zero());
+        }
+        self.pdf_with(wo, wi, ms, self.ms_probability(wo, ms))
+    }
+
+    /// The mixture density with the multiple-scattering lobe chosen with probability `p_ms`.
+    #[inline(always)]
+    fn pdf_with(&self, wo: V3<F>, wi: V3<F>, ms: F::Mask, p_ms: F) -> F {
         let zero = F::zero();
         let h = (wo + wi).normalize();
         let ok = wo.z.gt(zero) & wi.z.gt(zero) & !self.smooth;
-        let pdf = self.dist.d(h) / (F::splat(2.0) * (wo.z + self.dist.stretched_len(wo)));
+        let single = self.dist.d(h) / (F::splat(2.0) * (wo.z + self.dist.stretched_len(wo)));
+        let pdf = if ms.none() {
+            single
+        } else {
+            let cosine = wi.z * F::splat(std::f32::consts::FRAC_1_PI);
+            (F::one() - p_ms) * single + p_ms * cosine
+        };
         F::select(ok, pdf, zero)
     }
+
+    /// F_avg = 2∫F(μ)μ dμ per channel: Gauss–Legendre in x = μ² (F(√x) is smooth), four
+    /// nodes, which hold every metal's and Schlick's average to 1e-3.
+    #[inline(always)]
+    fn fresnel_average(&self) -> Chan<F, N> {
+        let mut acc = [F::zero(); N];
+        for (x, w) in GAUSS4 {
+            let f = self.fresnel.eval(F::splat(x.sqrt() as f32));
+            for (a, f) in acc.iter_mut().zip(f.0) {
+                *a = f.mul_add(F::splat(w as f32), *a);
+            }
+        }
+        Chan(acc)
+    }
+}
+
+/// The largest f32 below 1: where a rescaled uniform must stay.
+const ONE_MINUS_EPS: f32 = 1.0 - f32::EPSILON / 2.0;
+
+/// Four-node Gauss–Legendre rule on [0, 1]: (node, weight).
+const GAUSS4: [(f64, f64); 4] = [
+    (0.069_431_844_202_973_7, 0.173_927_422_568_726_9),
+    (0.330_009_478_207_571_9, 0.326_072_577_431_273_1),
+    (0.669_990_521_792_428_1, 0.326_072_577_431_273_1),
+    (0.930_568_155_797_026_3, 0.173_927_422_568_726_9),
+];
+
+/// E(μ, α) from the table, bilinear, μ and α clamped to [0, 1].
+#[inline(always)]
+pub fn ggx_albedo_lanes<F: Float>(mu: F, alpha: F) -> F {
+    let last = (GGX_TABLE_SIZE - 1) as f32;
+    let x = mu.clamp(F::zero(), F::one()) * F::splat(last);
+    let y = alpha.clamp(F::zero(), F::one()) * F::splat(last);
+    let (xi, yi) = (
+        x.floor().min(F::splat(last - 1.0)),
+        y.floor().min(F::splat(last - 1.0)),
+    );
+    let (fx, fy) = (x - xi, y - yi);
+    let i = (yi * F::splat(GGX_TABLE_SIZE as f32) + xi).to_i32_bits();
+    let one = F::U32::splat(1);
+    let row = F::U32::splat(GGX_TABLE_SIZE as u32);
+    let t = GGX_E.as_flattened();
+    let a = F::gather(t, i);
+    let b = F::gather(t, i.wrapping_add(one));
+    let c = F::gather(t, i.wrapping_add(row));
+    let d = F::gather(t, i.wrapping_add(row).wrapping_add(one));
+    let top = a + (b - a) * fx;
+    let bottom = c + (d - c) * fx;
+    top + (bottom - top) * fy
+}
+
+/// E_avg(α) from the table, linear, α clamped to [0, 1].
+#[inline(always)]
+pub fn ggx_average_albedo_lanes<F: Float>(alpha: F) -> F {
+    let last = (GGX_TABLE_SIZE - 1) as f32;
+    let y = alpha.clamp(F::zero(), F::one()) * F::splat(last);
+    let yi = y.floor().min(F::splat(last - 1.0));
+    let f = y - yi;
+    let i = yi.to_i32_bits();
+    let a = F::gather(&GGX_E_AVG, i);
+    let b = F::gather(&GGX_E_AVG, i.wrapping_add(F::U32::splat(1)));
+    a + (b - a) * f
+}
+
+/// E(μ, α), the directional albedo of a GGX lobe with F = 1 at incidence cosine μ, in f64:
+/// ∫ D(h)·G2(wo, wi)·|wo·h| / μ dωh over the normals reflecting wo above the surface
+/// (f = D·G2/(4 μo μi), dωi = 4|wo·h| dωh), by the midpoint rule in (cos θh = 1 − t², φ),
+/// a grid dense where narrow lobes are. The generator of the committed tables.
+pub fn ggx_albedo(mu: f64, alpha: f64) -> f64 {
+    use std::f64::consts::PI;
+    if alpha <= 0.0 {
+        return 1.0;
+    }
+    let mu = mu.clamp(1e-4, 1.0);
+    let wo = [(1.0 - mu * mu).sqrt(), 0.0, mu];
+    let a2 = alpha * alpha;
+    let s = |w: [f64; 3]| (a2 * (w[0] * w[0] + w[1] * w[1]) + w[2] * w[2]).sqrt();
+    let (nt, np) = (1024, 256);
+    let mut e = 0.0;
+    for i in 0..nt {
+        let t = (i as f64 + 0.5) / nt as f64;
+        let cos = 1.0 - t * t;
+        let sin = (1.0 - cos * cos).max(0.0).sqrt();
+        let dcos = 2.0 * t / nt as f64;
+        // wo lies in the xz plane: the integrand is even in φ, so half the circle, twice.
+        for j in 0..np {
+            let phi = (j as f64 + 0.5) / np as f64 * PI;
+            let h = [sin * phi.cos(), sin * phi.sin(), cos];
+            let oh = wo[0] * h[0] + wo[2] * h[2];
+            if oh <= 0.0 {
+                continue;
+            }
+            let wi = [
+                2.0 * oh * h[0] - wo[0],
+                2.0 * oh * h[1],
+                2.0 * oh * h[2] - wo[2],
+            ];
+            if wi[2] <= 0.0 {
+                continue;
+            }
+            let q = (h[0] * h[0] + h[1] * h[1]) / a2 + h[2] * h[2];
+            let d = 1.0 / (PI * a2 * q * q);
+            let g2 = 2.0 * wo[2] * wi[2] / (s(wo) * wi[2] + s(wi) * wo[2]);
+            e += d * g2 * oh / mu * dcos * (2.0 * PI / np as f64);
+        }
+    }
+    e
+}
+
+/// E_avg(α) = 2∫E(μ)μ dμ (midpoint rule, 64 nodes), in f64.
+pub fn ggx_average_albedo(alpha: f64) -> f64 {
+    let n = 64;
+    (0..n)
+        .map(|i| {
+            let mu = (i as f64 + 0.5) / n as f64;
+            2.0 * ggx_albedo(mu, alpha) * mu / n as f64
+        })
+        .sum()
 }

@@ -30,6 +30,7 @@ pub mod bsdf;
 pub mod ctx;
 mod emission;
 pub mod generate;
+mod ggx_tables;
 pub mod kernel;
 mod light;
 mod material;

@@ -36,9 +36,11 @@ pub(super) struct Surface<F: Float, const N: usize> {
     /// Albedo (Diffuse) or tint (Mirror), texture-modulated; a Conductor's η (or Schlick's
     /// normal-incidence reflectance).
     pub(super) color: C<F, N>,
-    /// A Conductor's GGX α, and the conductor lanes with Schlick's Fresnel form.
+    /// A Conductor's GGX α, and the conductor lanes with Schlick's Fresnel form and with
+    /// multiple-scattering compensation.
     pub(super) alpha: F,
     pub(super) schlick: M<F>,
+    pub(super) multiscatter: M<F>,
     /// Each lane's material index (for a dielectric's IOR model) and primitive (for the
     /// medium behind a dielectric).
     pub(super) mat: [u32; MAX_W],
@@ -57,6 +59,7 @@ impl<F: Float, const N: usize> Surface<F, N> {
         Conductor {
             dist: Ggx::isotropic(self.alpha),
             smooth: self.alpha.lt(F::splat(SMOOTH_ALPHA)),
+            multiscatter: self.multiscatter,
             fresnel: ConductorFresnel {
                 eta: self.color,
                 k: self.le,
@@ -135,6 +138,7 @@ struct Shading<T: Transport> {
     /// Conductor lanes, and those among them with Schlick's Fresnel form.
     conductor_bits: u32,
     schlick_bits: u32,
+    multiscatter_bits: u32,
 }
 
 impl<T: Transport> Shading<T> {
@@ -163,10 +167,15 @@ impl<T: Transport> Shading<T> {
                 T::set_reflectance(&mut self.color, i, ctx, h.mat, tint, textured);
             }
             Material::Dielectric { .. } => self.class[i] = CLASS_DIELECTRIC,
-            Material::Conductor { ior, alpha } => {
+            Material::Conductor {
+                ior,
+                alpha,
+                multiscatter,
+            } => {
                 self.class[i] = CLASS_CONDUCTOR;
                 self.alpha[i] = alpha;
                 self.conductor_bits |= 1 << i;
+                self.multiscatter_bits |= u32::from(multiscatter) << i;
                 let schlick = T::set_conductor(
                     &mut self.color,
                     &mut self.le,
@@ -234,6 +243,7 @@ pub(super) fn surfaces<
         emit_bits: 0,
         conductor_bits: 0,
         schlick_bits: 0,
+        multiscatter_bits: 0,
     };
     let mut mats = [0u32; MAX_W];
     let mut prim = [0u32; MAX_W];
@@ -324,6 +334,7 @@ pub(super) fn surfaces<
         color: T::eval(&shade.color, &st.lam),
         alpha: F::load(&shade.alpha),
         schlick: mask_from_bits::<F>(shade.schlick_bits),
+        multiscatter: mask_from_bits::<F>(shade.multiscatter_bits),
         mat: mats,
         prim,
         emits: mask_from_bits::<F>(shade.emit_bits),

@@ -613,7 +613,16 @@ fn build_world(
                 reflectance,
                 alpha,
                 roughness,
+                multiscatter,
             }) => conductor(*metal, *eta, *k, *reflectance, *alpha, *roughness)
+                .map(|m| match m {
+                    Material::Conductor { ior, alpha, .. } => Material::Conductor {
+                        ior,
+                        alpha,
+                        multiscatter: multiscatter.unwrap_or(true),
+                    },
+                    m => m,
+                })
                 .map_err(|(field, m)| err(field, m))?,
             Some(schema::Material::Light {
                 emission,
@@ -782,5 +791,9 @@ fn conductor(
         }
         (None, None) => 0.0,
     };
-    Ok(Material::Conductor { ior, alpha })
+    Ok(Material::Conductor {
+        ior,
+        alpha,
+        multiscatter: true,
+    })
 }

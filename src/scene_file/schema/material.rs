@@ -43,6 +43,11 @@ pub enum Material {
         /// Perceptual roughness r in [0, 1] (glTF, Blender): α = r².
         #[serde(default)]
         roughness: Option<f32>,
+        /// Restore the energy single scattering among the microfacets loses (Kulla & Conty
+        /// 2017); default `true`. `false` matches renderers without it (Mitsuba's
+        /// `roughconductor`, pbrt-v4's `conductor`).
+        #[serde(default)]
+        multiscatter: Option<bool>,
     },
     /// An area light on a Sphere, Rect or Disk; it emits and does not scatter.
     Light {
