@@ -1,12 +1,13 @@
 //! Conductors in the renderer: a white rough conductor in a white furnace reflects exactly the
-//! single-scattering albedo of GGX (computed here by quadrature in f64), a smooth one is a
-//! mirror, light sampling and BSDF sampling agree on a lit rough sphere, and measured metals
+//! single-scattering albedo of GGX (the f64 quadrature of `microfacet::ggx_albedo`) without
+//! compensation and all the light with it, a smooth one is a mirror, light sampling and BSDF sampling agree on a lit rough sphere, and measured metals
 //! render in both transports.
 
 mod common;
 use common::render::{image, mean_where, run, scene};
+use prism::integrator::microfacet::ggx_average_albedo;
 use prism::scene::Effect;
-use std::f64::consts::{PI, TAU};
+use std::f64::consts::PI;
 
 /// A unit sphere seen from 400 units away, filling a 48×48 image to a radius of ≈ 19 px: the
 /// view rays are parallel to 1/400, so the sphere's points are seen at cosines distributed
@@ -56,61 +57,6 @@ fn sphere_mean_in(material: &str, spp: u32, seed: u32, extra: &str, spectral: bo
     })
 }
 
-/// GGX (isotropic α) in f64: D, and the stretched length s(w) of the Smith terms.
-fn ggx_d(h: [f64; 3], a: f64) -> f64 {
-    let t = (h[0] * h[0] + h[1] * h[1]) / (a * a) + h[2] * h[2];
-    1.0 / (PI * a * a * t * t)
-}
-
-fn stretched(w: [f64; 3], a: f64) -> f64 {
-    (a * a * (w[0] * w[0] + w[1] * w[1]) + w[2] * w[2]).sqrt()
-}
-
-/// E(μ) = ∫ D(h)·G2(wo, wi)·|wo·h| / μ dωh over the normals h reflecting wo = (√(1 − μ²), 0, μ)
-/// above the surface (f = D·G2/(4 μo μi) with F = 1, dωi = 4|wo·h| dωh), by the midpoint rule
-/// in (cos θh = 1 − t², φ), a grid dense where the lobe is.
-fn albedo(mu: f64, a: f64) -> f64 {
-    let wo = [(1.0 - mu * mu).sqrt(), 0.0, mu];
-    let (nt, np) = (500, 192);
-    let mut e = 0.0;
-    for i in 0..nt {
-        let t = (i as f64 + 0.5) / nt as f64;
-        let cos = 1.0 - t * t;
-        let sin = (1.0 - cos * cos).max(0.0).sqrt();
-        let dcos = 2.0 * t / nt as f64;
-        for j in 0..np {
-            let phi = (j as f64 + 0.5) / np as f64 * TAU;
-            let h = [sin * phi.cos(), sin * phi.sin(), cos];
-            let oh = wo[0] * h[0] + wo[2] * h[2];
-            if oh <= 0.0 {
-                continue;
-            }
-            let wi = [
-                2.0 * oh * h[0] - wo[0],
-                2.0 * oh * h[1],
-                2.0 * oh * h[2] - wo[2],
-            ];
-            if wi[2] <= 0.0 {
-                continue;
-            }
-            let g2 = 2.0 * wo[2] * wi[2] / (stretched(wo, a) * wi[2] + stretched(wi, a) * wo[2]);
-            e += ggx_d(h, a) * g2 * oh / mu * dcos * TAU / np as f64;
-        }
-    }
-    e
-}
-
-/// E_avg = 2∫ E(μ) μ dμ.
-fn average_albedo(a: f64) -> f64 {
-    let n = 48;
-    (0..n)
-        .map(|i| {
-            let mu = (i as f64 + 0.5) / n as f64;
-            2.0 * albedo(mu, a) * mu / n as f64
-        })
-        .sum()
-}
-
 /// The geometry the furnace relies on: a black sphere removes exactly its disc's share of
 /// the environment.
 #[test]
@@ -126,7 +72,7 @@ fn far_sphere_covers_its_predicted_area() {
 #[test]
 fn white_furnace_gives_the_single_scattering_albedo() {
     for (alpha, spp) in [(0.3, 32), (0.6, 64), (1.0, 64)] {
-        let want = average_albedo(alpha);
+        let want = ggx_average_albedo(alpha);
         // Single scattering loses up to ~60 % at α = 1 (Heitz 2016, Kulla & Conty 2017).
         assert!(want < 1.0 && want > 0.35, "E_avg({alpha}) = {want}");
         let got = sphere_mean(

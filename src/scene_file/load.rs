@@ -713,7 +713,7 @@ fn build_world(
 /// A `Conductor` from its scene fields: exactly one source of its Fresnel term, at most one
 /// of `alpha` and `roughness`, each value in its range. An error names the field it is about.
 fn conductor(
-    metal: Option<schema::MetalName>,
+    metal: Option<crate::spectrum::Metal>,
     eta: Option<schema::Color>,
     k: Option<schema::Color>,
     reflectance: Option<schema::Albedo>,
@@ -744,7 +744,7 @@ fn conductor(
         }
     };
     let ior = match (metal, eta, k, reflectance) {
-        (Some(m), None, None, None) => ConductorIor::metal(m.metal()),
+        (Some(m), None, None, None) => ConductorIor::metal(m),
         (None, Some(eta), Some(k), None) => ConductorIor::Complex {
             eta: complex(eta, "material.eta", true)?,
             k: complex(k, "material.k", false)?,

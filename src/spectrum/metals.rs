@@ -4,8 +4,9 @@
 use super::metals_data::{METAL_FIRST_NM, METAL_NK, METAL_ROWS, METAL_STEP_NM};
 use glam::Vec3;
 
-/// A metal with a measured complex IOR (tables and their sources: `scripts/metal_tables.py`).
-#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash)]
+/// A metal with a measured complex IOR (tables and their sources: `scripts/metal_tables.py`),
+/// named in scene files by its chemical symbol.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, serde::Deserialize)]
 pub enum Metal {
     /// Gold.
     Au,

@@ -27,7 +27,7 @@ pub enum Material {
     Conductor {
         /// A measured metal: `Au`, `Ag`, `Cu`, `Al`, `Cr`, `Ti`, `Ni` or `Pt`.
         #[serde(default)]
-        metal: Option<MetalName>,
+        metal: Option<crate::spectrum::Metal>,
         /// The real part of the complex IOR per channel, each in (0, 100].
         #[serde(default)]
         eta: Option<Color>,
@@ -58,44 +58,6 @@ pub enum Material {
         #[serde(default)]
         two_sided: bool,
     },
-}
-
-/// A measured metal, by its chemical symbol.
-#[derive(Clone, Copy, Debug, Deserialize)]
-pub enum MetalName {
-    /// Gold.
-    Au,
-    /// Silver.
-    Ag,
-    /// Copper.
-    Cu,
-    /// Aluminium.
-    Al,
-    /// Chromium.
-    Cr,
-    /// Titanium.
-    Ti,
-    /// Nickel.
-    Ni,
-    /// Platinum.
-    Pt,
-}
-
-impl MetalName {
-    /// The metal's tables.
-    pub fn metal(self) -> crate::spectrum::Metal {
-        use crate::spectrum::Metal;
-        match self {
-            MetalName::Au => Metal::Au,
-            MetalName::Ag => Metal::Ag,
-            MetalName::Cu => Metal::Cu,
-            MetalName::Al => Metal::Al,
-            MetalName::Cr => Metal::Cr,
-            MetalName::Ti => Metal::Ti,
-            MetalName::Ni => Metal::Ni,
-            MetalName::Pt => Metal::Pt,
-        }
-    }
 }
 
 /// Index of refraction: `Constant(n)`, `Cauchy(a:, b:)` (λ in µm), `Sellmeier(b:, c:)` (c in
