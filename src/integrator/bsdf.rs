@@ -45,8 +45,6 @@ pub mod lobe {
     pub const SPECULAR: u32 = SPECULAR_REFLECTION | SPECULAR_TRANSMISSION;
     /// Reflection from a rough surface: a density, so light sampling evaluates it.
     pub const GLOSSY_REFLECTION: u32 = 8;
-    /// Transmission through a rough surface.
-    pub const GLOSSY_TRANSMISSION: u32 = 16;
 }
 
 /// Colour channels over lanes: what BSDF weights are made of. The transports' scalar channel
