@@ -4,58 +4,9 @@
 //! render in both transports.
 
 mod common;
-use common::render::{image, mean_where, run, scene};
+use common::furnace::{sphere_mean, sphere_mean_in};
+use common::render::{image, mean_where};
 use prism::integrator::microfacet::ggx_average_albedo;
-use prism::scene::Effect;
-use std::f64::consts::PI;
-
-/// A unit sphere seen from 400 units away, filling a 48×48 image to a radius of ≈ 19 px: the
-/// view rays are parallel to 1/400, so the sphere's points are seen at cosines distributed
-/// as 2μ dμ over its disc.
-const DIST: f64 = 400.0;
-const FOV_Y: f64 = 0.35;
-const SIZE: u32 = 48;
-
-fn far_sphere(material: &str, spp: u32, seed: u32, extra: &str) -> String {
-    format!(
-        r#"#![enable(implicit_some)]
-Scene(
-    render: (width: {SIZE}, height: {SIZE}, spp: {spp}, max_depth: 16, seed: {seed}{extra}),
-    camera: (position: (0.0, 0.0, {DIST}), look_at: (0.0, 0.0, 0.0), fov_y: {FOV_Y}),
-    environment: Constant(Rgb(1.0, 1.0, 1.0)),
-    entities: [ (name: "ball", shape: Sphere(center: (0.0, 0.0, 0.0), radius: 1.0), material: {material}) ],
-)"#
-    )
-}
-
-/// The sphere's share of the image: its silhouette is the cone of half-angle asin(1/d), a
-/// disc of radius tan(asin(1/d)) / tan(fov/2) · H/2 pixels.
-fn sphere_fraction() -> f64 {
-    let half = (FOV_Y.to_radians() / 2.0).tan();
-    let r = (1.0 / DIST).asin().tan() / half * f64::from(SIZE) / 2.0;
-    PI * r * r / f64::from(SIZE * SIZE)
-}
-
-/// The mean radiance over the sphere's disc, from the whole image's mean: the pixel filter
-/// is a partition of unity, so the image mean is the exact area mean of the radiance, and
-/// the background is the environment's 1.
-fn sphere_mean(material: &str, spp: u32, seed: u32, extra: &str) -> [f64; 3] {
-    sphere_mean_in(material, spp, seed, extra, false)
-}
-
-/// [`sphere_mean`] in RGB or spectral transport.
-fn sphere_mean_in(material: &str, spp: u32, seed: u32, extra: &str, spectral: bool) -> [f64; 3] {
-    let mut s = scene(&far_sphere(material, spp, seed, extra));
-    if spectral {
-        s.effects.force(Effect::Spectral).unwrap();
-    }
-    let img = run(&s).image();
-    let f = sphere_fraction();
-    std::array::from_fn(|c| {
-        let all = mean_where(&img, c, |_, _| true);
-        1.0 - (1.0 - all) / f
-    })
-}
 
 /// The geometry the furnace relies on: a black sphere removes exactly its disc's share of
 /// the environment.
@@ -204,7 +155,7 @@ fn measured_metals_render_in_both_transports() {
     for metal in ["Au", "Ag", "Cu", "Al", "Cr", "Ti", "Ni", "Pt"] {
         let m = format!("Conductor(metal: {metal}, alpha: 0.2)");
         let rgb = sphere_mean(&m, 16, 1, "");
-        let sp = sphere_mean_in(&m, 16, 1, "", true);
+        let sp = sphere_mean_in(&m, 16, 1, "", true, 16);
         for c in 0..3 {
             assert!(rgb[c].is_finite() && sp[c].is_finite());
             // Gold's red is near 1 at normal incidence, and compensation restores the rest.

@@ -178,7 +178,7 @@ fn prism_spreads_the_spectrum_in_order_at_the_predicted_places() {
         .query::<(&prism::components::Name, &prism::components::Material)>()
         .iter()
         .find_map(|(n, m)| match m {
-            prism::components::Material::Dielectric { ior } if n.0 == "prism" => Some(*ior),
+            prism::components::Material::Dielectric { ior, .. } if n.0 == "prism" => Some(*ior),
             _ => None,
         })
         .expect("prism.ron has a dielectric called \"prism\"");

@@ -5,10 +5,10 @@
 mod common;
 use common::chi2::Chi2;
 use glam::{DVec2, Vec3};
-use prism::integrator::bsdf::{Chan, lobe};
+use prism::integrator::bsdf::{Chan, Mode, lobe};
 use prism::integrator::microfacet::{
-    Conductor, ConductorFresnel, Ggx, fresnel_conductor, fresnel_schlick_r0, ggx_albedo,
-    ggx_albedo_lanes, ggx_average_albedo, ggx_average_albedo_lanes,
+    Conductor, ConductorFresnel, Ggx, RoughDielectric, fresnel_conductor, fresnel_schlick_r0,
+    ggx_albedo, ggx_albedo_lanes, ggx_average_albedo, ggx_average_albedo_lanes,
 };
 use prism::simd::{self, Float, LaneKernel, Lanes, Mask, V3};
 
@@ -338,6 +338,20 @@ impl LaneKernel for Conductors<'_> {
                 vals.extend(s.weight.0);
                 vals.extend(cd.eval(wo, wi).0);
             }
+            let uc = F::from_fn(|l| (at(l).2[0] + at(l).2[1]).fract());
+            for (eta, schlick) in [(1.5, false), (1.0 / 1.5, false), (1.33, true)] {
+                let d = RoughDielectric {
+                    dist: Ggx { ax, ay },
+                    eta: F::splat(eta),
+                    schlick,
+                };
+                let s = d.sample::<Chan<F, 1>>(wo, uc, u1, u2, Mode::Radiance);
+                vals.extend([s.wi.x, s.wi.y, s.wi.z, s.pdf, s.weight.0[0], d.pdf(wo, wi)]);
+                vals.extend([
+                    d.eval(wo, wi, Mode::Radiance),
+                    d.eval(wo, wi, Mode::Importance),
+                ]);
+            }
             for l in 0..w {
                 if base + l < c.len() {
                     out[base + l] = vals.iter().map(|x| x.lane(l).to_bits()).collect();
@@ -345,6 +359,174 @@ impl LaneKernel for Conductors<'_> {
             }
         }
         out
+    }
+}
+
+fn glass(alpha: f32, eta: f32) -> RoughDielectric<f32> {
+    RoughDielectric {
+        dist: Ggx::isotropic(alpha),
+        eta,
+        schlick: false,
+    }
+}
+
+/// Reflected and refracted directions together follow `pdf` over the whole sphere, at α =
+/// 0.05, 0.3 and 1, at normal, oblique and grazing incidence, entering glass and leaving it
+/// (where total internal reflection takes every microfacet beyond the critical angle).
+#[test]
+fn rough_dielectric_sampling_follows_its_pdf() {
+    let alphas = [0.05f32, 0.3, 1.0];
+    let thetas = [0.0f32, 45.0, 85.0];
+    let etas = [1.5f32, 1.0 / 1.5];
+    let tests = alphas.len() * thetas.len() * etas.len();
+    for (k, &alpha) in alphas.iter().enumerate() {
+        for (j, &theta) in thetas.iter().enumerate() {
+            for (e, &eta) in etas.iter().enumerate() {
+                let b = glass(alpha, eta);
+                let wo = incident(theta);
+                // The lobe's uniform from its own stream: the χ² harness draws two.
+                let mut g = SplitMix((k * 100 + j * 10 + e) as u64);
+                let sample = |u: glam::Vec2| {
+                    let uc = g.range(0.0, 1.0) as f32;
+                    let s = b.sample::<Chan<f32, 1>>(wo, uc, u.x, u.y, Mode::Radiance);
+                    (s.pdf > 0.0).then(|| Vec3::from(s.wi))
+                };
+                let pdf = |w: Vec3| b.pdf(wo, w.into());
+                let r = Chi2::new(400_000, (k * 31 + j * 7 + e) as u64)
+                    .tests(tests)
+                    .max_depth(7)
+                    .directions([0.0, 2.0], sample, pdf);
+                if let Err(err) = r {
+                    panic!("α = {alpha}, θ = {theta}°, η = {eta}: {err}");
+                }
+            }
+        }
+    }
+}
+
+/// Each sample's pdf is `pdf(wo, wi)` and its weight f·|cos|/pdf; reflected weights are
+/// G2/G1 ≤ 1, refracted radiance is scaled by 1/η² and importance is not.
+#[test]
+fn rough_dielectric_weight_is_f_cos_over_pdf() {
+    let mut g = SplitMix(21);
+    for &alpha in &[0.05f32, 0.3, 1.0] {
+        for &eta in &[1.5f32, 1.0 / 1.5, 2.4] {
+            let b = glass(alpha, eta);
+            for _ in 0..20_000 {
+                let wo = incident(g.range(0.0, 89.0) as f32);
+                let u = [0; 3].map(|_| g.range(0.0, 1.0) as f32);
+                for mode in [Mode::Radiance, Mode::Importance] {
+                    let s = b.sample::<Chan<f32, 1>>(wo, u[0], u[1], u[2], mode);
+                    let weight = s.weight.0[0];
+                    if s.pdf == 0.0 {
+                        assert_eq!(weight, 0.0);
+                        continue;
+                    }
+                    let t = s.wi.z < 0.0;
+                    let want = if t {
+                        lobe::GLOSSY_TRANSMISSION
+                    } else {
+                        lobe::GLOSSY_REFLECTION
+                    };
+                    assert_eq!(s.lobe, want);
+                    assert_eq!(s.eta, if t { eta } else { 1.0 });
+                    let pdf = b.pdf(wo, s.wi);
+                    let ctx = format!("α {alpha}, η {eta}, wo {wo:?}, wi {:?}", s.wi);
+                    assert!(
+                        (s.pdf - pdf).abs() <= 2e-3 * pdf,
+                        "{ctx}: {} vs {pdf}",
+                        s.pdf
+                    );
+                    let w = b.eval(wo, s.wi, mode) * s.wi.z.abs() / pdf;
+                    assert!(
+                        (w - weight).abs() <= 2e-3 * w.max(1e-3),
+                        "{ctx}: {w} vs {weight}"
+                    );
+                    let scale = if t && mode == Mode::Radiance {
+                        1.0 / (eta * eta)
+                    } else {
+                        1.0
+                    };
+                    assert!(weight <= scale * (1.0 + 1e-5), "{ctx}: {weight}");
+                }
+            }
+        }
+    }
+}
+
+/// Reflection is reciprocal; refraction is adjoint: importance from wo to wi equals radiance
+/// from wi to wo through the same interface seen from the other side (η → 1/η), which is
+/// f_t(wo, wi)/η_o² = f_t(wi, wo)/η_i² of the physical BTDF.
+#[test]
+fn rough_dielectric_is_reciprocal_and_adjoint() {
+    let mut g = SplitMix(22);
+    let up = |g: &mut SplitMix| {
+        let z = g.range(0.02, 1.0) as f32;
+        let phi = g.range(0.0, std::f64::consts::TAU) as f32;
+        let r = (1.0 - z * z).sqrt();
+        V3::<f32>::new(r * phi.cos(), r * phi.sin(), z)
+    };
+    let flip = |w: V3<f32>| V3::new(w.x, w.y, -w.z);
+    let (mut transmitted, mut reflected) = (0, 0);
+    for &eta in &[1.5f32, 1.0 / 1.33] {
+        let (b, back) = (glass(0.35, eta), glass(0.35, 1.0 / eta));
+        for _ in 0..20_000 {
+            let (a, c) = (up(&mut g), up(&mut g));
+            let (fac, fca) = (b.eval(a, c, Mode::Radiance), b.eval(c, a, Mode::Radiance));
+            assert!((fac - fca).abs() <= 1e-4 * fac.max(1.0), "{fac} vs {fca}");
+            reflected += usize::from(fac > 0.0);
+            // a above, c below: the reverse path leaves c on the far side.
+            let wi = flip(c);
+            let imp = b.eval(a, wi, Mode::Importance);
+            let rad = back.eval(c, flip(a), Mode::Radiance);
+            // Near the critical angle 1 − F, seen from the dense side, is ill-conditioned in
+            // f32: its cosine on the thin side comes from cos² = (η² − 1 + cos²θi)/η², a
+            // cancellation. Pairs whose facet cosine on the thin side is under 0.05 are
+            // compared more loosely.
+            let h = (wi * eta + a).normalize();
+            let thin = if eta > 1.0 { a.dot(h) } else { wi.dot(h) }.abs();
+            let tol = if thin < 0.05 { 2e-2 } else { 1e-3 };
+            assert!(
+                (imp - rad).abs() <= tol * imp.max(1e-2),
+                "η {eta}: {imp} vs {rad}, a {a:?} c {c:?}"
+            );
+            transmitted += usize::from(imp > 0.0);
+        }
+    }
+    // Every reflected pair has a facet between its directions; a refraction needs one facing
+    // both, which a fair share of random pairs have.
+    assert!(
+        reflected > 30_000 && transmitted > 5_000,
+        "{reflected} {transmitted}"
+    );
+}
+
+/// Energy: ∫ f |cos| dω over the sphere, by the sampled weights' mean, is at most 1 (single
+/// scattering only loses energy), and at normal incidence on a nearly smooth interface all
+/// but 1 % survives (the smooth limit loses nothing).
+#[test]
+fn rough_dielectric_conserves_energy() {
+    let mut g = SplitMix(23);
+    for &alpha in &[0.05f32, 0.3, 1.0] {
+        for &eta in &[1.5f32, 1.0 / 1.5] {
+            let b = glass(alpha, eta);
+            for theta in [0.0f32, 40.0, 75.0] {
+                let wo = incident(theta);
+                let n = 200_000;
+                let sum: f64 = (0..n)
+                    .map(|_| {
+                        let u = [0; 3].map(|_| g.range(0.0, 1.0) as f32);
+                        let s = b.sample::<Chan<f32, 1>>(wo, u[0], u[1], u[2], Mode::Importance);
+                        f64::from(s.weight.0[0])
+                    })
+                    .sum();
+                let e = sum / f64::from(n);
+                assert!(e <= 1.0 + 1e-6, "α {alpha}, η {eta}, θ {theta}: {e}");
+                if alpha <= 0.05 && theta == 0.0 {
+                    assert!(e >= 0.99, "α {alpha}, η {eta}, θ {theta}: {e}");
+                }
+            }
+        }
     }
 }
 

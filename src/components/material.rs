@@ -32,11 +32,14 @@ pub enum Material {
         /// Reflectance per linear sRGB channel, in [0, 1].
         tint: Vec3,
     },
-    /// Smooth glass: Fresnel-weighted reflection and refraction. A wavelength-dependent IOR
-    /// disperses light (spectral transport only).
+    /// Glass: Fresnel-weighted reflection and refraction, smooth or (α at least
+    /// [`crate::integrator::microfacet::SMOOTH_ALPHA`]) through GGX microfacets. A
+    /// wavelength-dependent IOR disperses light (spectral transport only).
     Dielectric {
         /// Refractive index of the glass as a function of wavelength.
         ior: IorModel,
+        /// GGX roughness α (isotropic), in [0, 1]; 0 is smooth.
+        alpha: f32,
     },
     /// A metal: GGX microfacet reflection with a conductor's Fresnel term; a mirror weighted
     /// by that term when `alpha` is below [`crate::integrator::microfacet::SMOOTH_ALPHA`].
@@ -191,7 +194,7 @@ impl std::fmt::Display for Material {
         match self {
             Material::Diffuse { albedo } => write!(f, "Diffuse(albedo: {})", Rgb(*albedo)),
             Material::Mirror { tint } => write!(f, "Mirror(tint: {})", Rgb(*tint)),
-            Material::Dielectric { ior } => {
+            Material::Dielectric { ior, alpha } => {
                 let ior = match IorPreset::ALL.into_iter().find(|p| p.model() == *ior) {
                     Some(p) => format!("Preset({})", p.name()),
                     None => match ior {
@@ -204,7 +207,11 @@ impl std::fmt::Display for Material {
                         IorModel::Sellmeier4 { b, c } => format!("Sellmeier4(b: {b:?}, c: {c:?})"),
                     },
                 };
-                write!(f, "Dielectric(ior: {ior})")
+                if *alpha > 0.0 {
+                    write!(f, "Dielectric(ior: {ior}, alpha: {alpha:?})")
+                } else {
+                    write!(f, "Dielectric(ior: {ior})")
+                }
             }
             Material::Conductor {
                 ior,
@@ -273,18 +280,28 @@ mod tests {
             (
                 Material::Dielectric {
                     ior: IorModel::Constant(1.5),
+                    alpha: 0.0,
                 },
                 "Dielectric(ior: Constant(1.5))",
             ),
             (
                 Material::Dielectric {
+                    ior: IorModel::Constant(1.5),
+                    alpha: 0.25,
+                },
+                "Dielectric(ior: Constant(1.5), alpha: 0.25)",
+            ),
+            (
+                Material::Dielectric {
                     ior: IorModel::Cauchy { a: 1.5, b: 0.004 },
+                    alpha: 0.0,
                 },
                 "Dielectric(ior: Cauchy(a: 1.5, b: 0.004))",
             ),
             (
                 Material::Dielectric {
                     ior: IorPreset::Water.model(),
+                    alpha: 0.0,
                 },
                 "Dielectric(ior: Preset(Water))",
             ),

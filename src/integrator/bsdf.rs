@@ -45,6 +45,10 @@ pub mod lobe {
     pub const SPECULAR: u32 = SPECULAR_REFLECTION | SPECULAR_TRANSMISSION;
     /// Reflection from a rough surface: a density, so light sampling evaluates it.
     pub const GLOSSY_REFLECTION: u32 = 8;
+    /// Refraction through a rough interface: a density, like glossy reflection.
+    pub const GLOSSY_TRANSMISSION: u32 = 16;
+    /// Either transmission lobe: the path crosses into the other medium.
+    pub const TRANSMISSION: u32 = SPECULAR_TRANSMISSION | GLOSSY_TRANSMISSION;
 }
 
 /// Colour channels over lanes: what BSDF weights are made of. The transports' scalar channel
@@ -152,7 +156,7 @@ impl<F: Float, S> BsdfSample<F, S> {
     /// Lanes whose sample refracted.
     #[inline(always)]
     pub fn is_transmission(&self) -> F::Mask {
-        !(self.lobe & F::U32::splat(lobe::SPECULAR_TRANSMISSION)).eq(F::U32::splat(0))
+        !(self.lobe & F::U32::splat(lobe::TRANSMISSION)).eq(F::U32::splat(0))
     }
 }
 
@@ -311,9 +315,12 @@ pub fn refract_local<F: Float>(wo: V3<F>, eta: F) -> (V3<F>, F::Mask) {
 pub fn fresnel_dielectric<F: Float>(cos_i: F, eta: F) -> F {
     let one = F::one();
     let cos_i = cos_i.clamp(F::zero(), one);
-    let sin2_t = (one - cos_i * cos_i) / (eta * eta);
-    let tir = sin2_t.ge(one);
-    let cos_t = (one - sin2_t).max(F::zero()).sqrt();
+    // cos²θt = 1 − sin²θi/η², formed without the cancellation of 1 − sin²θt when the
+    // transmitted ray grazes (its cosine sets 1 − F there).
+    let e2 = eta * eta;
+    let cos2_t = (e2 - one + cos_i * cos_i) / e2;
+    let tir = cos2_t.le(F::zero());
+    let cos_t = cos2_t.max(F::zero()).sqrt();
     let r_parl = (eta * cos_i - cos_t) / (eta * cos_i + cos_t);
     let r_perp = (cos_i - eta * cos_t) / (cos_i + eta * cos_t);
     let r = F::splat(0.5) * (r_parl * r_parl + r_perp * r_perp);

@@ -1,21 +1,32 @@
-//! Light samples: next-event estimation at the lanes whose BSDF has a density (diffuse and
-//! rough conductors), a light chosen and sampled per lane, its BSDF value and MIS weight over
-//! lanes, then its shadow ray.
+//! Light samples: next-event estimation at the lanes whose BSDF has a density (diffuse, rough
+//! conductors and rough dielectrics), a light chosen and sampled per lane, its BSDF value and
+//! MIS weight over lanes, then its shadow ray (from the far side of a rough dielectric when
+//! the light is behind it).
 
 use super::RenderStats;
-use super::bsdf::{Chan, Diffuse, Frame};
+use super::bsdf::{Chan, Diffuse, Frame, LaneChannels, Mode};
 use super::ctx::Ctx;
-use super::shadow;
+use super::microfacet::RoughDielectric;
 use super::state::{C, M, MAX_W, Paths, U, gdot, power_heuristic, select_c};
 use super::surface::Surface;
 use super::transport::{ChannelArray, Transport};
+use super::{media, shadow};
 use crate::scene::light_lanes::LaneLightSample;
 use crate::scene::lights::LightSource;
 use crate::simd::{Float, Mask, UInt};
 
-/// Next-event estimation at the lanes `dm`, diffuse but for the rough conductors `glossy`: a
-/// light sample per lane, its BSDF value and MIS weight over lanes, then a shadow ray per lane
-/// whose contribution is not zero.
+/// The lanes whose BSDF has a density other than the diffuse one.
+pub(super) struct Glossy<F: Float> {
+    /// Rough conductors (their BSDF is the surface's [`Surface::conductor`]).
+    pub(super) conductor: M<F>,
+    /// Rough dielectrics, and their BSDF.
+    pub(super) dielectric: M<F>,
+    pub(super) rough_dielectric: RoughDielectric<F>,
+}
+
+/// Next-event estimation at the lanes `dm`, diffuse but for those in `glossy`: a light sample
+/// per lane, its BSDF value and MIS weight over lanes, then a shadow ray per lane whose
+/// contribution is not zero.
 #[inline(always)]
 #[allow(clippy::too_many_arguments)]
 pub(super) fn light_samples<
@@ -29,7 +40,7 @@ pub(super) fn light_samples<
     st: &mut Paths<F, T, N>,
     sf: &Surface<F, N>,
     dm: M<F>,
-    glossy: M<F>,
+    glossy: &Glossy<F>,
     frame: &Frame<F>,
     dim: U<F>,
     stats: &mut RenderStats,
@@ -57,17 +68,27 @@ pub(super) fn light_samples<
     let wi = ls.wi;
     let wi_l = frame.to_local(wi);
     let cos = wi_l.z;
-    let ok = ls.has & cos.gt(F::zero()) & gdot(wi, sf.nf).gt(F::zero());
+    let side = gdot(wi, sf.nf);
+    // Lights behind a rough dielectric are seen through it: below both the shading and the
+    // geometric surface.
+    let through = glossy.dielectric & cos.lt(F::zero()) & side.lt(F::zero());
+    let ok = ls.has & ((cos.gt(F::zero()) & side.gt(F::zero())) | through);
     if ok.none() {
         return;
     }
     let bsdf = Diffuse { albedo: sf.color };
     let mut bsdf_pdf = bsdf.pdf(wo_l, wi_l);
     let mut f = bsdf.eval(wo_l, wi_l) * cos;
-    if glossy.any() {
-        let c = sf.conductor();
-        bsdf_pdf = F::select(glossy, c.pdf(wo_l, wi_l), bsdf_pdf);
-        f = select_c(glossy, c.eval(wo_l, wi_l) * cos, f);
+    if glossy.conductor.any() {
+        let (c, m) = (sf.conductor(), glossy.conductor);
+        bsdf_pdf = F::select(m, c.pdf(wo_l, wi_l), bsdf_pdf);
+        f = select_c(m, c.eval(wo_l, wi_l) * cos, f);
+    }
+    if glossy.dielectric.any() {
+        let (d, m) = (&glossy.rough_dielectric, glossy.dielectric);
+        bsdf_pdf = F::select(m, d.pdf(wo_l, wi_l), bsdf_pdf);
+        let fd = d.eval(wo_l, wi_l, Mode::Radiance) * cos.abs();
+        f = select_c(m, C::<F, N>::splat(fd), f);
     }
     let pdf = ls.pdf;
     let w = F::select(ls.delta, F::one(), power_heuristic(pdf, bsdf_pdf));
@@ -75,7 +96,16 @@ pub(super) fn light_samples<
     let contrib = st.beta * f * rad * (w / pdf);
     let shoot = ok & !contrib.is_zero();
     let (so, sd, t_max) = shadow::from_surface(sf.p, sf.nf, &ls);
-    shadow::trace::<F, T, N, MOTION, MEDIA>(ctx, st, so, sd, t_max, contrib, shoot, stats);
+    let crossing = shoot & through;
+    if MEDIA && crossing.any() {
+        // A shadow ray through the interface starts in the medium beyond it.
+        let (medium, in_medium) = (st.medium, st.in_medium);
+        media::cross(ctx, st, sf, crossing);
+        shadow::trace::<F, T, N, MOTION, MEDIA>(ctx, st, so, sd, t_max, contrib, shoot, stats);
+        (st.medium, st.in_medium) = (medium, in_medium);
+    } else {
+        shadow::trace::<F, T, N, MOTION, MEDIA>(ctx, st, so, sd, t_max, contrib, shoot, stats);
+    }
 }
 
 /// Each lane's light-sample radiance in the transport's channels, for the lanes in `m`.

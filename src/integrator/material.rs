@@ -1,9 +1,11 @@
 //! Materials: one scattering event per lane, a BSDF sample for each material class present
 //! (a class no lane needs is skipped), light samples at the lanes whose BSDF has a density
-//! (diffuse and rough conductors), then Russian roulette.
+//! (diffuse, rough conductors and rough dielectrics), then Russian roulette.
 
 use super::bsdf::{Dielectric, Diffuse, Frame, Mirror, Mode};
 use super::ctx::{Ctx, DIM_BOUNCE, DIMS_PER_BOUNCE};
+use super::light::Glossy;
+use super::microfacet::{Ggx, RoughDielectric, SMOOTH_ALPHA};
 use super::state::{C, M, MAX_W, Paths, U, gdot, gnormalize, mask_from_bits, select_c};
 use super::surface::{CLASS_CONDUCTOR, CLASS_DIELECTRIC, CLASS_DIFFUSE, CLASS_MIRROR, Surface};
 use super::transport::{ChannelArray, Transport};
@@ -12,8 +14,8 @@ use crate::components::Material;
 use crate::geometry::offset_ray_origin_lanes;
 use crate::simd::{Float, Mask, UInt, V3};
 
-/// One scattering event in every lane of `live`: light samples at diffuse and rough
-/// conductor lanes, then a BSDF sample per material class present, then Russian roulette.
+/// One scattering event in every lane of `live`: light samples at the lanes whose BSDF has
+/// a density, then a BSDF sample per material class present, then Russian roulette.
 #[inline(always)]
 pub(super) fn scatter<
     F: Float,
@@ -41,16 +43,33 @@ pub(super) fn scatter<
         class(CLASS_DIELECTRIC),
     );
     let cm = class(CLASS_CONDUCTOR);
-    // Rough conductors have a density: light sampling evaluates them, as it does diffuse
-    // surfaces. Smooth ones are delta lobes, like mirrors.
+    // The dielectric lanes' relative IOR comes first: a dispersive one ends the lane's
+    // secondary wavelengths before a light sample evaluates the interface at the hero's.
+    let eta = if em.any() {
+        dielectric_eta::<F, T, N>(ctx, st, sf, em)
+    } else {
+        F::one()
+    };
+    // Rough conductors and dielectrics have a density: light sampling evaluates them, as it
+    // does diffuse surfaces. Smooth ones are delta lobes, like mirrors. An interface with
+    // η = 1 is none: it refracts every microfacet normal into the same direction, a delta.
     let conductor = sf.conductor();
-    let glossy = cm.and_not(conductor.smooth);
+    let rough = sf.alpha.ge(F::splat(SMOOTH_ALPHA));
+    let glossy = Glossy {
+        conductor: cm & rough,
+        dielectric: em & rough & !eta.eq(F::one()),
+        rough_dielectric: RoughDielectric {
+            dist: Ggx::isotropic(sf.alpha),
+            eta,
+            schlick: ctx.schlick,
+        },
+    };
     let up = offset_ray_origin_lanes(sf.p, sf.nf);
     let mut scattered = M::<F>::splat(false);
-    let nee = dm | glossy;
+    let nee = dm | glossy.conductor | glossy.dielectric;
     if ctx.nee && nee.any() {
         light::light_samples::<F, T, N, MOTION, MEDIA>(
-            ctx, st, sf, nee, glossy, &frame, dim, stats,
+            ctx, st, sf, nee, &glossy, &frame, dim, stats,
         );
     }
     if dm.any() {
@@ -96,28 +115,8 @@ pub(super) fn scatter<
         st.d = V3::select(mm, reflect_above(wi, sf.nf), st.d);
         scattered |= mm;
     }
-    if em.any() {
-        // The IOR per lane; a dispersive one ends the lane's secondary wavelengths.
-        let prims = &ctx.scene.prims;
-        let mut ior = [1.0f32; MAX_W];
-        let mut dispersive = 0u32;
-        let bits = em.bits();
-        for (i, n) in ior.iter_mut().enumerate().take(F::WIDTH) {
-            if bits >> i & 1 != 0 {
-                let Material::Dielectric { ior: model } = prims.materials[sf.mat[i] as usize]
-                else {
-                    continue;
-                };
-                let (eta, disperses) = T::ior(&model, &st.lam, i);
-                *n = eta;
-                dispersive |= (disperses as u32) << i;
-            }
-        }
-        if dispersive != 0 {
-            T::terminate_secondary(&mut st.lam, &mut st.beta, mask_from_bits::<F>(dispersive));
-        }
-        let ior = F::load(&ior);
-        let eta = F::select(sf.front, ior, ior.recip());
+    let es = em.and_not(glossy.dielectric);
+    if es.any() {
         let u =
             ctx.sampler
                 .get_1d_lanes::<F>(st.pixel, st.sample, dim.wrapping_add(U::<F>::splat(3)));
@@ -126,10 +125,10 @@ pub(super) fn scatter<
             schlick: ctx.schlick,
         };
         let bs = bsdf.sample::<C<F, N>>(wo_l, u, Mode::Radiance);
-        st.specular |= em;
-        st.beta = select_c(em, st.beta * bs.weight, st.beta);
+        st.specular |= es;
+        st.beta = select_c(es, st.beta * bs.weight, st.beta);
         let wi = frame.to_world(bs.wi);
-        let t = em & bs.is_transmission();
+        let t = es & bs.is_transmission();
         st.eta_scale = F::select(t, st.eta_scale * (bs.eta * bs.eta), st.eta_scale);
         let down = offset_ray_origin_lanes(sf.p, -sf.nf);
         let o = V3::select(t, down, up);
@@ -137,12 +136,74 @@ pub(super) fn scatter<
         if MEDIA {
             media::cross(ctx, st, sf, t);
         }
-        st.o = V3::select(em, o, st.o);
-        st.d = V3::select(em, d, st.d);
-        scattered |= em;
+        st.o = V3::select(es, o, st.o);
+        st.d = V3::select(es, d, st.d);
+        scattered |= es;
+    }
+    let er = glossy.dielectric;
+    if er.any() {
+        let u =
+            ctx.sampler
+                .get_1d_lanes::<F>(st.pixel, st.sample, dim.wrapping_add(U::<F>::splat(3)));
+        let (ux, uy) =
+            ctx.sampler
+                .get_2d_lanes::<F>(st.pixel, st.sample, dim.wrapping_add(U::<F>::splat(4)));
+        let bs = glossy
+            .rough_dielectric
+            .sample::<C<F, N>>(wo_l, u, ux, uy, Mode::Radiance);
+        let wi = frame.to_world(bs.wi).normalize();
+        // A direction on the wrong geometric side for its lobe (about a tilted shading
+        // normal) is absorbed, as for rough conductors.
+        let t = bs.is_transmission();
+        let side = gdot(wi, sf.nf);
+        let ok = er & bs.pdf.gt(F::zero()) & F::select(t, -side, side).gt(F::zero());
+        let t = ok & t;
+        st.alive = st.alive.and_not(er.and_not(ok));
+        st.beta = select_c(ok, st.beta * bs.weight, st.beta);
+        st.prev_pdf = F::select(ok, bs.pdf, st.prev_pdf);
+        st.specular = st.specular.and_not(ok);
+        st.eta_scale = F::select(t, st.eta_scale * (bs.eta * bs.eta), st.eta_scale);
+        let down = offset_ray_origin_lanes(sf.p, -sf.nf);
+        if MEDIA {
+            media::cross(ctx, st, sf, t);
+        }
+        st.o = V3::select(ok, V3::select(t, down, up), st.o);
+        st.d = V3::select(ok, wi, st.d);
+        scattered |= ok;
     }
     st.prev_p = V3::select(scattered, sf.p, st.prev_p);
     roulette::russian_roulette(ctx, st, scattered, dim.wrapping_add(U::<F>::splat(6)));
+}
+
+/// The relative IOR (transmitted over incident) of the dielectric lanes `em` at each lane's
+/// hero wavelength; a dispersive interface ends the lane's secondary wavelengths.
+#[inline(always)]
+fn dielectric_eta<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize>(
+    ctx: &Ctx,
+    st: &mut Paths<F, T, N>,
+    sf: &Surface<F, N>,
+    em: M<F>,
+) -> F {
+    let prims = &ctx.scene.prims;
+    let mut ior = [1.0f32; MAX_W];
+    let mut dispersive = 0u32;
+    let bits = em.bits();
+    for (i, n) in ior.iter_mut().enumerate().take(F::WIDTH) {
+        if bits >> i & 1 != 0 {
+            let Material::Dielectric { ior: model, .. } = prims.materials[sf.mat[i] as usize]
+            else {
+                continue;
+            };
+            let (eta, disperses) = T::ior(&model, &st.lam, i);
+            *n = eta;
+            dispersive |= (disperses as u32) << i;
+        }
+    }
+    if dispersive != 0 {
+        T::terminate_secondary(&mut st.lam, &mut st.beta, mask_from_bits::<F>(dispersive));
+    }
+    let ior = F::load(&ior);
+    F::select(sf.front, ior, ior.recip())
 }
 
 /// A reflected direction kept on the side of `n`: at grazing angles (or about a tilted

@@ -22,7 +22,10 @@
 //! reflects all the light at every roughness. E and E_avg come from tables this module's
 //! quadrature generates (`examples/ggx_tables.rs`, committed in `ggx_tables.rs`).
 
-use super::bsdf::{BsdfSample, Chan, lobe, reflect_local};
+use super::bsdf::{
+    BsdfSample, Chan, LaneChannels, Mode, fresnel_dielectric, fresnel_schlick, lobe, reflect_local,
+    refract_lanes,
+};
 use super::ggx_tables::{GGX_E, GGX_E_AVG, GGX_TABLE_SIZE};
 use crate::simd::{Float, Mask, UInt, V3, math};
 use std::f32::consts::TAU;
@@ -339,6 +342,146 @@ impl<F: Float, const N: usize> Conductor<F, N> {
             }
         }
         Chan(acc)
+    }
+}
+
+/// A rough dielectric interface (Walter et al. 2007): GGX microfacets that each reflect with
+/// their Fresnel probability and otherwise refract. `eta` is the relative IOR across it in the
+/// direction of travel (transmitted over incident, the incident side being `+z`), as for the
+/// smooth [`super::bsdf::Dielectric`].
+///
+/// Sampling draws a visible normal h, then reflection with probability F(wo·h) or refraction
+/// about h. With the generalised half vector h ∝ η·wi + wo of a refraction and
+/// dωh/dωi = |wi·h| / (wi·h + wo·h/η)²,
+/// - f_r = D·F·G2 / (4 zo zi) and pdf_r = F·D / (2(zo + s(wo))),
+/// - f_t = (1 − F)·D·G2·|wi·h||wo·h| / (|zi| zo (wi·h + wo·h/η)²), over η² for radiance,
+///   and pdf_t = (1 − F)·G1(wo)·D·(wo·h)/zo · dωh/dωi,
+///
+/// so every sample's weight is G2/G1(wo), over η² for refracted radiance.
+#[derive(Clone, Copy, Debug)]
+pub struct RoughDielectric<F: Float> {
+    /// The microfacet distribution.
+    pub dist: Ggx<F>,
+    /// Relative IOR, transmitted over incident; not 1 (an interface that is none refracts
+    /// every normal into the same direction, a delta the smooth form handles).
+    pub eta: F,
+    /// Use Schlick's Fresnel approximation instead of the exact formula.
+    pub schlick: bool,
+}
+
+impl<F: Float> RoughDielectric<F> {
+    /// The microfacet's Fresnel reflectance at `cos` = wo·h.
+    #[inline(always)]
+    fn fresnel(&self, cos: F) -> F {
+        if self.schlick {
+            fresnel_schlick(cos, self.eta)
+        } else {
+            fresnel_dielectric(cos, self.eta)
+        }
+    }
+
+    /// 1/η² on refracted radiance, 1 on importance (and on reflection).
+    #[inline(always)]
+    fn scale(&self, mode: Mode) -> F {
+        match mode {
+            Mode::Radiance => (self.eta * self.eta).recip(),
+            Mode::Importance => F::one(),
+        }
+    }
+
+    /// A visible normal, then reflection about it with probability F or refraction. Lanes
+    /// whose direction ends on the wrong side for its lobe have weight 0 and pdf 0.
+    #[inline(always)]
+    pub fn sample<S: LaneChannels<F>>(
+        &self,
+        wo: V3<F>,
+        uc: F,
+        u1: F,
+        u2: F,
+        mode: Mode,
+    ) -> BsdfSample<F, S> {
+        let (zero, one) = (F::zero(), F::one());
+        let h = self.dist.sample_visible_normal(wo, u1, u2);
+        let cos_o = wo.dot(h);
+        let r = self.fresnel(cos_o);
+        let (wt, can_refract) = refract_lanes(wo, h, self.eta);
+        let t = can_refract & uc.ge(r);
+        let wi = V3::select(t, wt, h * (F::splat(2.0) * cos_o) - wo);
+        let (zo, zi) = (wo.z, wi.z);
+        let ok = zo.gt(zero) & cos_o.gt(zero) & F::select(t, -zi, zi).gt(zero);
+        let (so, si) = (self.dist.stretched_len(wo), self.dist.stretched_len(wi));
+        let azi = zi.abs();
+        // G2/G1(wo) with both in the stretched-length form.
+        let g = azi * (zo + so) / (so * azi + si * zo);
+        let d = self.dist.d(h);
+        let pdf_r = d * r / (F::splat(2.0) * (zo + so));
+        let cos_i = wi.dot(h);
+        let denom = cos_i + cos_o / self.eta;
+        let pdf_t =
+            F::splat(2.0) * d * cos_o / (zo + so) * cos_i.abs() / (denom * denom) * (one - r);
+        let pdf = F::select(ok, F::select(t, pdf_t, pdf_r), zero);
+        let weight = F::select(ok, g * F::select(t, self.scale(mode), one), zero);
+        BsdfSample {
+            wi,
+            weight: S::splat(weight),
+            pdf,
+            lobe: F::U32::select(
+                t,
+                F::U32::splat(lobe::GLOSSY_TRANSMISSION),
+                F::U32::splat(lobe::GLOSSY_REFLECTION),
+            ),
+            eta: F::select(t, self.eta, one),
+        }
+    }
+
+    /// The generalised half vector of `wo` and `wi` (turned to `+z`), its cosines with both,
+    /// and the lanes where it is a microfacet normal that scatters `wo` into `wi` (both
+    /// directions on its front, `wo` above the surface).
+    #[inline(always)]
+    fn half(&self, wo: V3<F>, wi: V3<F>) -> (V3<F>, F, F, F::Mask, F::Mask) {
+        let zero = F::zero();
+        let reflect = wi.z.gt(zero);
+        let etap = F::select(reflect, F::one(), self.eta);
+        let m = wi * etap + wo;
+        let len2 = m.dot(m);
+        let inv = len2.sqrt().recip();
+        let h = m * F::select(m.z.lt(zero), -inv, inv);
+        let (cos_o, cos_i) = (wo.dot(h), wi.dot(h));
+        let ok = wo.z.gt(zero)
+            & !wi.z.eq(zero)
+            & len2.gt(zero)
+            & cos_o.gt(zero)
+            & (cos_i * wi.z).gt(zero);
+        (h, cos_o, cos_i, reflect, ok)
+    }
+
+    /// f(wo, wi) (no cosine): colourless, one value per lane.
+    #[inline(always)]
+    pub fn eval(&self, wo: V3<F>, wi: V3<F>, mode: Mode) -> F {
+        let (zero, two) = (F::zero(), F::splat(2.0));
+        let (h, cos_o, cos_i, reflect, ok) = self.half(wo, wi);
+        let (zo, azi) = (wo.z, wi.z.abs());
+        let d = self.dist.d(h);
+        let r = self.fresnel(cos_o);
+        // D·G2/(4 zo |zi|) = D / (2 (s(wo)|zi| + s(wi) zo)).
+        let dg = d / (two * (self.dist.stretched_len(wo) * azi + self.dist.stretched_len(wi) * zo));
+        let denom = cos_i + cos_o / self.eta;
+        let ft = (F::one() - r) * dg * F::splat(4.0) * (cos_i * cos_o).abs() / (denom * denom)
+            * self.scale(mode);
+        F::select(ok, F::select(reflect, r * dg, ft), zero)
+    }
+
+    /// The solid-angle density of [`RoughDielectric::sample`] drawing `wi`.
+    #[inline(always)]
+    pub fn pdf(&self, wo: V3<F>, wi: V3<F>) -> F {
+        let (zero, two) = (F::zero(), F::splat(2.0));
+        let (h, cos_o, cos_i, reflect, ok) = self.half(wo, wi);
+        let zo = wo.z;
+        let vis = self.dist.d(h) / (two * (zo + self.dist.stretched_len(wo)));
+        let r = self.fresnel(cos_o);
+        let denom = cos_i + cos_o / self.eta;
+        let pt = (F::one() - r) * vis * F::splat(4.0) * cos_o * cos_i.abs() / (denom * denom);
+        F::select(ok, F::select(reflect, r * vis, pt), zero)
     }
 }
 

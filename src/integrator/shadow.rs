@@ -27,8 +27,9 @@ pub(super) fn from_surface<F: Float>(
     let o_area = offset_ray_origin_lanes(p, n);
     let nt = V3::select(gdot(ls.nq, d).le(F::zero()), ls.nq, -ls.nq);
     let end = offset_ray_origin_lanes(ls.q, nt);
-    // Point lights and the environment leave from the surface's own side.
-    let o_up = offset_ray_origin_lanes(p, nf);
+    // Point lights and the environment: from the side the light is on (behind a rough
+    // dielectric it is the far side).
+    let o_up = offset_ray_origin_lanes(p, V3::select(gdot(nf, ls.wi).ge(F::zero()), nf, -nf));
     let area = ls.at_point.and_not(ls.delta);
     let o = V3::select(area, o_area, o_up);
     let dir = V3::select(

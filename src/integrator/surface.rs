@@ -36,8 +36,8 @@ pub(super) struct Surface<F: Float, const N: usize> {
     /// Albedo (Diffuse) or tint (Mirror), texture-modulated; a Conductor's η (or Schlick's
     /// normal-incidence reflectance).
     pub(super) color: C<F, N>,
-    /// A Conductor's GGX α, and the conductor lanes with Schlick's Fresnel form and with
-    /// multiple-scattering compensation.
+    /// A Conductor's or Dielectric's GGX α, and the conductor lanes with Schlick's Fresnel
+    /// form and with multiple-scattering compensation.
     pub(super) alpha: F,
     pub(super) schlick: M<F>,
     pub(super) multiscatter: M<F>,
@@ -166,7 +166,10 @@ impl<T: Transport> Shading<T> {
                 self.class[i] = CLASS_MIRROR;
                 T::set_reflectance(&mut self.color, i, ctx, h.mat, tint, textured);
             }
-            Material::Dielectric { .. } => self.class[i] = CLASS_DIELECTRIC,
+            Material::Dielectric { alpha, .. } => {
+                self.class[i] = CLASS_DIELECTRIC;
+                self.alpha[i] = alpha;
+            }
             Material::Conductor {
                 ior,
                 alpha,

@@ -605,7 +605,14 @@ fn build_world(
                 albedo: albedo.0.vec(),
             },
             Some(schema::Material::Mirror { tint }) => Material::Mirror { tint: tint.0.vec() },
-            Some(schema::Material::Dielectric { ior }) => Material::Dielectric { ior: ior.0 },
+            Some(schema::Material::Dielectric {
+                ior,
+                alpha,
+                roughness,
+            }) => Material::Dielectric {
+                ior: ior.0,
+                alpha: rough_alpha(*alpha, *roughness).map_err(|(field, m)| err(field, m))?,
+            },
             Some(schema::Material::Conductor {
                 metal,
                 eta,
@@ -770,6 +777,16 @@ fn conductor(
             ));
         }
     };
+    Ok(Material::Conductor {
+        ior,
+        alpha: rough_alpha(alpha, roughness)?,
+        multiscatter: true,
+    })
+}
+
+/// A rough material's GGX α from its `alpha` or `roughness` field (α = roughness²), each in
+/// [0, 1], at most one of them; neither is smooth (α = 0).
+fn rough_alpha(alpha: Option<f32>, roughness: Option<f32>) -> Result<f32, (&'static str, String)> {
     let unit = |v: f32, field: &'static str| {
         if (0.0..=1.0).contains(&v) {
             Ok(v)
@@ -777,23 +794,13 @@ fn conductor(
             Err((field, format!("must be in [0, 1], got {v}")))
         }
     };
-    let alpha = match (alpha, roughness) {
-        (Some(_), Some(_)) => {
-            return Err((
-                "material.roughness",
-                "give `alpha` or `roughness` (α = roughness²), not both".into(),
-            ));
-        }
-        (Some(a), None) => unit(a, "material.alpha")?,
-        (None, Some(r)) => {
-            let r = unit(r, "material.roughness")?;
-            r * r
-        }
-        (None, None) => 0.0,
-    };
-    Ok(Material::Conductor {
-        ior,
-        alpha,
-        multiscatter: true,
-    })
+    match (alpha, roughness) {
+        (Some(_), Some(_)) => Err((
+            "material.roughness",
+            "give `alpha` or `roughness` (α = roughness²), not both".into(),
+        )),
+        (Some(a), None) => unit(a, "material.alpha"),
+        (None, Some(r)) => unit(r, "material.roughness").map(|r| r * r),
+        (None, None) => Ok(0.0),
+    }
 }

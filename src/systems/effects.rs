@@ -76,7 +76,7 @@ pub fn detect_effects(
         .query::<(hecs::Entity, &Name, &Material)>()
         .iter()
         .filter_map(|(e, n, m)| match m {
-            Material::Dielectric { ior } if ior.is_dispersive() => Some((
+            Material::Dielectric { ior, .. } if ior.is_dispersive() => Some((
                 e,
                 format!(
                     "entity {}: {}",

@@ -16,10 +16,17 @@ pub enum Material {
         /// Reflectance, every channel in [0, 1].
         tint: Albedo,
     },
-    /// Smooth glass: Fresnel-weighted specular reflection and refraction.
+    /// Glass: Fresnel-weighted reflection and refraction, smooth or rough (GGX microfacets,
+    /// Walter et al. 2007). At most one of `alpha` and `roughness` (neither: smooth).
     Dielectric {
         /// Index of refraction inside the surface; outside it is 1.
         ior: Ior,
+        /// GGX α in [0, 1] (as Mitsuba's `alpha`): frosted glass.
+        #[serde(default)]
+        alpha: Option<f32>,
+        /// Perceptual roughness r in [0, 1] (glTF, Blender): α = r².
+        #[serde(default)]
+        roughness: Option<f32>,
     },
     /// A metal: GGX microfacet reflection (smooth below α = 0.001) with a conductor's Fresnel
     /// term. Exactly one of `metal`, `eta` with `k`, or `reflectance`; at most one of `alpha`
