@@ -664,6 +664,18 @@ fn errors_about_entities_after_parsing_carry_their_position() {
             "Conductor(",
             "entity \"ball\": field `material`: a Conductor takes one of",
         ),
+        (
+            ball,
+            "material: Plastic(albedo: Rgb(0.5, 0.5, 0.5), ior: 3.5)",
+            "3.5)",
+            "entity \"ball\": field `material.ior`: must be in [1, 3], got 3.5",
+        ),
+        (
+            ball,
+            "material: Dielectric(ior: Constant(1.5), roughness: 1.2)",
+            "1.2)",
+            "entity \"ball\": field `material.roughness`: must be in [0, 1], got 1.2",
+        ),
     ];
     for (from, to, marker, says) in cases {
         let text = GOOD.replace(",\n         material", ", material").replace(

@@ -10,6 +10,8 @@
 //! # let _ = m;
 //! let m: Material = ron::from_str("Conductor(metal: Some(Au), alpha: Some(0.2))").unwrap();
 //! # let _ = m;
+//! let m: Material = ron::from_str("Plastic(albedo: Rgb(0.8, 0.1, 0.1), roughness: Some(0.3))").unwrap();
+//! # let _ = m;
 //! let m: Material = ron::from_str("Light(emission: Rgb(17.0, 12.0, 4.0), two_sided: false)").unwrap();
 //! # let _ = m;
 //! ```
@@ -50,6 +52,17 @@ pub enum Material {
         alpha: f32,
         /// Restore the energy of light scattered among microfacets (Kulla & Conty 2017).
         multiscatter: bool,
+    },
+    /// Plastic: a dielectric coat of IOR `ior`, smooth or GGX-rough, over a Lambertian base
+    /// of reflectance `albedo`, the coat's internal reflections accounted for
+    /// ([`crate::integrator::coat`]).
+    Plastic {
+        /// The base's reflectance per linear sRGB channel, in [0, 1].
+        albedo: Vec3,
+        /// The coat's refractive index, in [1, 3].
+        ior: f32,
+        /// The coat's GGX roughness α (isotropic), in [0, 1]; 0 is smooth.
+        alpha: f32,
     },
     /// An area emitter of constant radiance: `emission` is its linear sRGB colour, `spectrum`
     /// what spectral transport evaluates.
@@ -108,6 +121,11 @@ impl Material {
         match self {
             Material::Diffuse { albedo } => Material::Diffuse { albedo: albedo * a },
             Material::Mirror { tint } => Material::Mirror { tint: tint * a },
+            Material::Plastic { albedo, ior, alpha } => Material::Plastic {
+                albedo: albedo * a,
+                ior,
+                alpha,
+            },
             Material::Light {
                 emission,
                 two_sided,
@@ -235,6 +253,13 @@ impl std::fmt::Display for Material {
                 }
                 f.write_str(")")
             }
+            Material::Plastic { albedo, ior, alpha } => {
+                write!(f, "Plastic(albedo: {}, ior: {ior:?}", Rgb(*albedo))?;
+                if *alpha > 0.0 {
+                    write!(f, ", alpha: {alpha:?}")?;
+                }
+                f.write_str(")")
+            }
             Material::Light {
                 emission,
                 two_sided,
@@ -290,6 +315,22 @@ mod tests {
                     alpha: 0.25,
                 },
                 "Dielectric(ior: Constant(1.5), alpha: 0.25)",
+            ),
+            (
+                Material::Plastic {
+                    albedo: Vec3::new(0.8, 0.1, 0.1),
+                    ior: 1.5,
+                    alpha: 0.0,
+                },
+                "Plastic(albedo: Rgb(0.8, 0.1, 0.1), ior: 1.5)",
+            ),
+            (
+                Material::Plastic {
+                    albedo: Vec3::ONE,
+                    ior: 1.4,
+                    alpha: 0.09,
+                },
+                "Plastic(albedo: Rgb(1.0, 1.0, 1.0), ior: 1.4, alpha: 0.09)",
             ),
             (
                 Material::Dielectric {

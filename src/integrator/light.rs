@@ -16,7 +16,10 @@ use crate::scene::lights::LightSource;
 use crate::simd::{Float, Mask, UInt};
 
 /// The lanes whose BSDF has a density other than the diffuse one.
-pub(super) struct Glossy<F: Float> {
+pub(super) struct Glossy<'a, F: Float> {
+    /// Plastics (their BSDF is the surface's [`Surface::plastic`] over `coat`).
+    pub(super) plastic: M<F>,
+    pub(super) coat: &'a [f32],
     /// Rough conductors (their BSDF is the surface's [`Surface::conductor`]).
     pub(super) conductor: M<F>,
     /// Rough dielectrics, and their BSDF.
@@ -40,7 +43,7 @@ pub(super) fn light_samples<
     st: &mut Paths<F, T, N>,
     sf: &Surface<F, N>,
     dm: M<F>,
-    glossy: &Glossy<F>,
+    glossy: &Glossy<'_, F>,
     frame: &Frame<F>,
     dim: U<F>,
     stats: &mut RenderStats,
@@ -83,6 +86,11 @@ pub(super) fn light_samples<
         let (c, m) = (sf.conductor(), glossy.conductor);
         bsdf_pdf = F::select(m, c.pdf(wo_l, wi_l), bsdf_pdf);
         f = select_c(m, c.eval(wo_l, wi_l) * cos, f);
+    }
+    if glossy.plastic.any() {
+        let (p, m) = (sf.plastic(glossy.coat), glossy.plastic);
+        bsdf_pdf = F::select(m, p.pdf(wo_l, wi_l), bsdf_pdf);
+        f = select_c(m, p.eval(wo_l, wi_l) * cos, f);
     }
     if glossy.dielectric.any() {
         let (d, m) = (&glossy.rough_dielectric, glossy.dielectric);

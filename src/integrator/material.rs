@@ -7,7 +7,9 @@ use super::ctx::{Ctx, DIM_BOUNCE, DIMS_PER_BOUNCE};
 use super::light::Glossy;
 use super::microfacet::{Ggx, RoughDielectric, SMOOTH_ALPHA};
 use super::state::{C, M, MAX_W, Paths, U, gdot, gnormalize, mask_from_bits, select_c};
-use super::surface::{CLASS_CONDUCTOR, CLASS_DIELECTRIC, CLASS_DIFFUSE, CLASS_MIRROR, Surface};
+use super::surface::{
+    CLASS_CONDUCTOR, CLASS_DIELECTRIC, CLASS_DIFFUSE, CLASS_MIRROR, CLASS_PLASTIC, Surface,
+};
 use super::transport::{ChannelArray, Transport};
 use super::{RenderStats, light, media, roulette};
 use crate::components::Material;
@@ -43,6 +45,7 @@ pub(super) fn scatter<
         class(CLASS_DIELECTRIC),
     );
     let cm = class(CLASS_CONDUCTOR);
+    let pm = class(CLASS_PLASTIC);
     // The dielectric lanes' relative IOR comes first: a dispersive one ends the lane's
     // secondary wavelengths before a light sample evaluates the interface at the hero's.
     let eta = if em.any() {
@@ -56,6 +59,8 @@ pub(super) fn scatter<
     let conductor = sf.conductor();
     let rough = sf.alpha.ge(F::splat(SMOOTH_ALPHA));
     let glossy = Glossy {
+        plastic: pm,
+        coat: &ctx.scene.prims.coat,
         conductor: cm & rough,
         dielectric: em & rough & !eta.eq(F::one()),
         rough_dielectric: RoughDielectric {
@@ -66,7 +71,8 @@ pub(super) fn scatter<
     };
     let up = offset_ray_origin_lanes(sf.p, sf.nf);
     let mut scattered = M::<F>::splat(false);
-    let nee = dm | glossy.conductor | glossy.dielectric;
+    // A plastic's base always has a density.
+    let nee = dm | pm | glossy.conductor | glossy.dielectric;
     if ctx.nee && nee.any() {
         light::light_samples::<F, T, N, MOTION, MEDIA>(
             ctx, st, sf, nee, &glossy, &frame, dim, stats,
@@ -99,6 +105,27 @@ pub(super) fn scatter<
         // side: absorbed, as for diffuse lanes. A smooth one is kept above, as a mirror's.
         let ok = cm & bs.pdf.gt(F::zero()) & (smooth | gdot(wi, sf.nf).gt(F::zero()));
         st.alive = st.alive.and_not(cm.and_not(ok));
+        st.beta = select_c(ok, st.beta * bs.weight, st.beta);
+        st.prev_pdf = F::select(ok, bs.pdf, st.prev_pdf);
+        st.specular = st.specular.and_not(ok) | (ok & smooth);
+        st.o = V3::select(ok, up, st.o);
+        st.d = V3::select(ok, V3::select(smooth, reflect_above(wi, sf.nf), wi), st.d);
+        scattered |= ok;
+    }
+    if pm.any() {
+        let uc =
+            ctx.sampler
+                .get_1d_lanes::<F>(st.pixel, st.sample, dim.wrapping_add(U::<F>::splat(3)));
+        let (ux, uy) =
+            ctx.sampler
+                .get_2d_lanes::<F>(st.pixel, st.sample, dim.wrapping_add(U::<F>::splat(4)));
+        let bs = sf.plastic(glossy.coat).sample(wo_l, uc, ux, uy);
+        let smooth = pm & bs.is_specular();
+        let wi = frame.to_world(bs.wi).normalize();
+        // As for conductors: a rough or diffuse direction into the geometric back side is
+        // absorbed, a smooth coat's mirror direction is kept above.
+        let ok = pm & bs.pdf.gt(F::zero()) & (smooth | gdot(wi, sf.nf).gt(F::zero()));
+        st.alive = st.alive.and_not(pm.and_not(ok));
         st.beta = select_c(ok, st.beta * bs.weight, st.beta);
         st.prev_pdf = F::select(ok, bs.pdf, st.prev_pdf);
         st.specular = st.specular.and_not(ok) | (ok & smooth);

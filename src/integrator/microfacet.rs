@@ -496,12 +496,18 @@ const GAUSS4: [(f64, f64); 4] = [
     (0.930_568_155_797_026_3, 0.173_927_422_568_726_9),
 ];
 
+/// `x` clamped to [0, 1], NaN to 0: a table index made of it stays inside the table.
+#[inline(always)]
+pub(crate) fn unit<F: Float>(x: F) -> F {
+    F::select(x.gt(F::zero()), x.min(F::one()), F::zero())
+}
+
 /// E(μ, α) from the table, bilinear, μ and α clamped to [0, 1].
 #[inline(always)]
 pub fn ggx_albedo_lanes<F: Float>(mu: F, alpha: F) -> F {
     let last = (GGX_TABLE_SIZE - 1) as f32;
-    let x = mu.clamp(F::zero(), F::one()) * F::splat(last);
-    let y = alpha.clamp(F::zero(), F::one()) * F::splat(last);
+    let x = unit(mu) * F::splat(last);
+    let y = unit(alpha) * F::splat(last);
     let (xi, yi) = (
         x.floor().min(F::splat(last - 1.0)),
         y.floor().min(F::splat(last - 1.0)),
@@ -524,7 +530,7 @@ pub fn ggx_albedo_lanes<F: Float>(mu: F, alpha: F) -> F {
 #[inline(always)]
 pub fn ggx_average_albedo_lanes<F: Float>(alpha: F) -> F {
     let last = (GGX_TABLE_SIZE - 1) as f32;
-    let y = alpha.clamp(F::zero(), F::one()) * F::splat(last);
+    let y = unit(alpha) * F::splat(last);
     let yi = y.floor().min(F::splat(last - 1.0));
     let f = y - yi;
     let i = yi.to_i32_bits();
@@ -538,15 +544,25 @@ pub fn ggx_average_albedo_lanes<F: Float>(alpha: F) -> F {
 /// (f = D·G2/(4 μo μi), dωi = 4|wo·h| dωh), by the midpoint rule in (cos θh = 1 − t², φ),
 /// a grid dense where narrow lobes are. The generator of the committed tables.
 pub fn ggx_albedo(mu: f64, alpha: f64) -> f64 {
+    ggx_albedo_with(mu, alpha, |_| 1.0, (1024, 256))
+}
+
+/// The directional albedo of a GGX lobe whose microfacets reflect `fresnel(wo·h)`, by the
+/// quadrature of [`ggx_albedo`] on an `nt` × `np` grid in (t, φ), cos θh = 1 − t².
+pub fn ggx_albedo_with(
+    mu: f64,
+    alpha: f64,
+    fresnel: impl Fn(f64) -> f64,
+    (nt, np): (usize, usize),
+) -> f64 {
     use std::f64::consts::PI;
     if alpha <= 0.0 {
-        return 1.0;
+        return fresnel(mu);
     }
     let mu = mu.clamp(1e-4, 1.0);
     let wo = [(1.0 - mu * mu).sqrt(), 0.0, mu];
     let a2 = alpha * alpha;
     let s = |w: [f64; 3]| (a2 * (w[0] * w[0] + w[1] * w[1]) + w[2] * w[2]).sqrt();
-    let (nt, np) = (1024, 256);
     let mut e = 0.0;
     for i in 0..nt {
         let t = (i as f64 + 0.5) / nt as f64;
@@ -572,7 +588,7 @@ pub fn ggx_albedo(mu: f64, alpha: f64) -> f64 {
             let q = (h[0] * h[0] + h[1] * h[1]) / a2 + h[2] * h[2];
             let d = 1.0 / (PI * a2 * q * q);
             let g2 = 2.0 * wo[2] * wi[2] / (s(wo) * wi[2] + s(wi) * wo[2]);
-            e += d * g2 * oh / mu * dcos * (2.0 * PI / np as f64);
+            e += fresnel(oh) * d * g2 * oh / mu * dcos * (2.0 * PI / np as f64);
         }
     }
     e

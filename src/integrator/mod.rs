@@ -27,6 +27,7 @@
 //! branch per ray. LENS, TEXTURES and NORMAL_MAPS are flags read once per render.
 
 pub mod bsdf;
+pub mod coat;
 pub mod ctx;
 mod emission;
 pub mod generate;

@@ -3,6 +3,7 @@
 //! emitters hit by chance with their radiance and MIS weight.
 
 use super::bsdf::LaneChannels;
+use super::coat::Plastic;
 use super::ctx::Ctx;
 use super::microfacet::{Conductor, ConductorFresnel, Ggx, SMOOTH_ALPHA};
 use super::state::{C, M, MAX_W, Paths, Scratch3, U, mask_from_bits, power_heuristic};
@@ -23,6 +24,7 @@ pub(super) const CLASS_DIELECTRIC: u32 = 3;
 /// MEDIA: a medium's boundary, crossed without scattering.
 pub(super) const CLASS_BOUNDARY: u32 = 4;
 pub(super) const CLASS_CONDUCTOR: u32 = 5;
+pub(super) const CLASS_PLASTIC: u32 = 6;
 
 /// What the surface stage found at each lane's hit point.
 pub(super) struct Surface<F: Float, const N: usize> {
@@ -41,6 +43,9 @@ pub(super) struct Surface<F: Float, const N: usize> {
     pub(super) alpha: F,
     pub(super) schlick: M<F>,
     pub(super) multiscatter: M<F>,
+    /// A Plastic's coat IOR and the offset of its coat tables (1 and 0 elsewhere).
+    pub(super) coat_ior: F,
+    pub(super) coat: U<F>,
     /// Each lane's material index (for a dielectric's IOR model) and primitive (for the
     /// medium behind a dielectric).
     pub(super) mat: [u32; MAX_W],
@@ -53,6 +58,20 @@ pub(super) struct Surface<F: Float, const N: usize> {
 }
 
 impl<F: Float, const N: usize> Surface<F, N> {
+    /// The plastic BSDF of the plastic lanes (meaningless in others), its coat tables in
+    /// `tables`.
+    #[inline(always)]
+    pub(super) fn plastic<'a>(&self, tables: &'a [f32]) -> Plastic<'a, F, N> {
+        Plastic {
+            dist: Ggx::isotropic(self.alpha),
+            smooth: self.alpha.lt(F::splat(SMOOTH_ALPHA)),
+            eta: self.coat_ior,
+            albedo: self.color,
+            tables,
+            base: self.coat,
+        }
+    }
+
     /// The conductor BSDF of the conductor lanes (meaningless in others).
     #[inline(always)]
     pub(super) fn conductor(&self) -> Conductor<F, N> {
@@ -134,6 +153,8 @@ struct Shading<T: Transport> {
     class: [u32; MAX_W],
     le_w: [f32; MAX_W],
     alpha: [f32; MAX_W],
+    coat_ior: [f32; MAX_W],
+    coat: [u32; MAX_W],
     emit_bits: u32,
     /// Conductor lanes, and those among them with Schlick's Fresnel form.
     conductor_bits: u32,
@@ -165,6 +186,13 @@ impl<T: Transport> Shading<T> {
             Material::Mirror { tint } => {
                 self.class[i] = CLASS_MIRROR;
                 T::set_reflectance(&mut self.color, i, ctx, h.mat, tint, textured);
+            }
+            Material::Plastic { albedo, ior, alpha } => {
+                self.class[i] = CLASS_PLASTIC;
+                self.alpha[i] = alpha;
+                self.coat_ior[i] = ior;
+                self.coat[i] = ctx.scene.prims.coat_offset[h.mat as usize];
+                T::set_reflectance(&mut self.color, i, ctx, h.mat, albedo, textured);
             }
             Material::Dielectric { alpha, .. } => {
                 self.class[i] = CLASS_DIELECTRIC;
@@ -243,6 +271,8 @@ pub(super) fn surfaces<
         class: [CLASS_NONE; MAX_W],
         le_w: [0.0; MAX_W],
         alpha: [0.0; MAX_W],
+        coat_ior: [1.0; MAX_W],
+        coat: [0; MAX_W],
         emit_bits: 0,
         conductor_bits: 0,
         schlick_bits: 0,
@@ -338,6 +368,8 @@ pub(super) fn surfaces<
         alpha: F::load(&shade.alpha),
         schlick: mask_from_bits::<F>(shade.schlick_bits),
         multiscatter: mask_from_bits::<F>(shade.multiscatter_bits),
+        coat_ior: F::load(&shade.coat_ior),
+        coat: U::<F>::from_fn(|i| shade.coat[i]),
         mat: mats,
         prim,
         emits: mask_from_bits::<F>(shade.emit_bits),

@@ -189,6 +189,7 @@ impl SpectralData {
             .map(|m| match *m {
                 Material::Diffuse { albedo } => RgbSigmoid::from_rgb(albedo),
                 Material::Mirror { tint } => RgbSigmoid::from_rgb(tint),
+                Material::Plastic { albedo, .. } => RgbSigmoid::from_rgb(albedo),
                 Material::Conductor {
                     ior: ConductorIor::Reflectance(r),
                     ..

@@ -182,6 +182,11 @@ pub struct Primitives {
     pub meshes: Vec<Placed<TriangleMesh>>,
     /// Every material of the scene.
     pub materials: Vec<Material>,
+    /// The coat tables of the scene's plastics, one per coat IOR
+    /// ([`crate::integrator::coat::coat_table`]).
+    pub coat: Vec<f32>,
+    /// Each material's offset into `coat` (0 for other materials).
+    pub coat_offset: Vec<u32>,
     /// Entity name of each primitive, for messages.
     pub names: Vec<String>,
 }

@@ -597,7 +597,7 @@ fn build_world(
             None => {
                 return Err(err(
                     "material",
-                    "a shape needs a material (Diffuse, Mirror, Conductor, Dielectric or Light)"
+                    "a shape needs a material (Diffuse, Mirror, Conductor, Dielectric, Plastic or Light)"
                         .into(),
                 ));
             }
@@ -605,6 +605,22 @@ fn build_world(
                 albedo: albedo.0.vec(),
             },
             Some(schema::Material::Mirror { tint }) => Material::Mirror { tint: tint.0.vec() },
+            Some(schema::Material::Plastic {
+                albedo,
+                ior,
+                alpha,
+                roughness,
+            }) => {
+                let ior = ior.unwrap_or(1.5);
+                if !(1.0..=3.0).contains(&ior) {
+                    return Err(err("material.ior", format!("must be in [1, 3], got {ior}")));
+                }
+                Material::Plastic {
+                    albedo: albedo.0.vec(),
+                    ior,
+                    alpha: rough_alpha(*alpha, *roughness).map_err(|(field, m)| err(field, m))?,
+                }
+            }
             Some(schema::Material::Dielectric {
                 ior,
                 alpha,
@@ -656,6 +672,7 @@ fn build_world(
             && matches!(
                 material,
                 Material::Mirror { .. }
+                    | Material::Plastic { .. }
                     | Material::Light { .. }
                     | Material::Diffuse { .. }
                     | Material::Conductor { .. }

@@ -129,5 +129,22 @@ pub fn gather_primitives(world: &hecs::World) -> Primitives {
             p.medium_outside[i] = p.medium_at_excluding(c, Some(i as u32));
         }
     }
+    // Plastics' coat tables, one per IOR.
+    let mut at: Vec<(u32, u32)> = Vec::new();
+    p.coat_offset = vec![0; p.materials.len()];
+    for (m, off) in p.materials.iter().zip(p.coat_offset.iter_mut()) {
+        if let Material::Plastic { ior, .. } = *m {
+            *off = match at.iter().find(|(bits, _)| *bits == ior.to_bits()) {
+                Some(&(_, o)) => o,
+                None => {
+                    let o = p.coat.len() as u32;
+                    p.coat
+                        .extend_from_slice(&crate::integrator::coat::coat_table_cached(ior));
+                    at.push((ior.to_bits(), o));
+                    o
+                }
+            };
+        }
+    }
     p
 }

@@ -56,6 +56,22 @@ pub enum Material {
         #[serde(default)]
         multiscatter: Option<bool>,
     },
+    /// Plastic: a dielectric coat over a Lambertian base (energy conserving, the coat's
+    /// internal reflections accounted for). At most one of `alpha` and `roughness` (neither:
+    /// a smooth, glossy coat).
+    Plastic {
+        /// The base's reflectance, every channel in [0, 1].
+        albedo: Albedo,
+        /// The coat's refractive index in [1, 3]; default 1.5.
+        #[serde(default)]
+        ior: Option<f32>,
+        /// The coat's GGX α in [0, 1].
+        #[serde(default)]
+        alpha: Option<f32>,
+        /// The coat's perceptual roughness r in [0, 1]: α = r².
+        #[serde(default)]
+        roughness: Option<f32>,
+    },
     /// An area light on a Sphere, Rect or Disk; it emits and does not scatter.
     Light {
         /// Emitted radiance.

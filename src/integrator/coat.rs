@@ -1,0 +1,317 @@
+//! Plastic: a dielectric coat (smooth or GGX-rough) over a Lambertian base, energy
+//! conserving with the coat's internal reflections accounted for.
+//!
+//! Light the coat does not reflect enters, scatters in the base and leaves through the coat;
+//! what the coat reflects back inside bounces on the base again. With E(μ) the coat's
+//! directional reflectance from outside (F(μ) for a smooth coat, the GGX lobe's albedo with
+//! the coat's Fresnel term for a rough one), E_avg = 2∫E(μ)μ dμ and F_in the coat's internal
+//! reflectance of diffuse light, the BSDF is
+//!
+//! f = f_coat + ρ_eff·(1 − E(μo))(1 − E(μi)) / (π(1 − E_avg)),  ρ_eff = ρ(1 − F_in)/(1 − ρF_in),
+//!
+//! ρ_eff summing the base's bounces under the coat. For a smooth coat (1 − E_avg) =
+//! η²(1 − F_in), which makes the second term Mitsuba's `plastic` exactly:
+//! ρ(1 − F(μo))(1 − F(μi)) / (πη²(1 − ρF_in)). The form is reciprocal, and with ρ = 1 a
+//! direction's albedo is E(μo) + (1 − E(μo)) = 1 exactly, whatever the accuracy of E, as long
+//! as E_avg is the integral of the same (interpolated) E: the tables hold it so.
+//!
+//! The tables depend on the coat's IOR, so they are built per IOR a scene uses (once per
+//! process) by f64 quadrature, on the grid of the GGX energy tables.
+
+use super::bsdf::{BsdfSample, Chan, fresnel_dielectric, lobe, reflect_local};
+use super::ggx_tables::GGX_TABLE_SIZE;
+use super::microfacet::{Ggx, ggx_albedo_with, unit};
+use crate::simd::{Float, Mask, UInt, V3};
+use std::collections::HashMap;
+use std::f32::consts::FRAC_1_PI;
+use std::sync::{Arc, Mutex, OnceLock};
+
+/// E(μ, α) on a `GGX_TABLE_SIZE`² grid (row per α), then E_avg(α), then the smooth coat's
+/// E_avg and F_in.
+pub const COAT_TABLE_LEN: usize = GGX_TABLE_SIZE * GGX_TABLE_SIZE + GGX_TABLE_SIZE + 2;
+const AVG: usize = GGX_TABLE_SIZE * GGX_TABLE_SIZE;
+const SMOOTH_AVG: usize = AVG + GGX_TABLE_SIZE;
+const F_IN: usize = SMOOTH_AVG + 1;
+
+/// Fresnel reflectance of a smooth dielectric interface in f64 (relative IOR `eta`).
+fn fresnel_f64(cos_i: f64, eta: f64) -> f64 {
+    let c = cos_i.clamp(0.0, 1.0);
+    let cos2_t = (eta * eta - 1.0 + c * c) / (eta * eta);
+    if cos2_t <= 0.0 {
+        return 1.0;
+    }
+    let ct = cos2_t.sqrt();
+    let rp = (eta * c - ct) / (eta * c + ct);
+    let rs = (c - eta * ct) / (c + eta * ct);
+    0.5 * (rp * rp + rs * rs)
+}
+
+/// 2∫F(μ)μ dμ for relative IOR `eta`, by the midpoint rule in x = μ² (F(√x) is smooth but
+/// for the kink at a critical angle, which 4096 nodes resolve to 1e-6).
+fn fresnel_average_f64(eta: f64) -> f64 {
+    let n = 4096;
+    (0..n)
+        .map(|i| fresnel_f64(((i as f64 + 0.5) / n as f64).sqrt(), eta) / n as f64)
+        .sum()
+}
+
+/// The coat tables of IOR `eta` (see [`COAT_TABLE_LEN`]).
+pub fn coat_table(eta: f32) -> Vec<f32> {
+    use rayon::prelude::*;
+    let n = GGX_TABLE_SIZE;
+    let last = (n - 1) as f64;
+    let eta = f64::from(eta);
+    let rows: Vec<Vec<f64>> = (0..n)
+        .into_par_iter()
+        .map(|j| {
+            let alpha = j as f64 / last;
+            (0..n)
+                .map(|i| {
+                    let mu = i as f64 / last;
+                    // A grid half as fine as the committed GGX tables': E enters the albedo
+                    // of a white plastic only as E_true − E_table (see the module's notes).
+                    ggx_albedo_with(mu, alpha, |c| fresnel_f64(c, eta), (512, 128)).min(1.0)
+                })
+                .collect()
+        })
+        .collect();
+    let mut t = Vec::with_capacity(COAT_TABLE_LEN);
+    for row in &rows {
+        t.extend(row.iter().map(|&e| e as f32));
+    }
+    // E_avg of the interpolated E: 2∫E(μ)μ dμ with E linear on each cell, integrated exactly
+    // (and from the f32 values the lookups read).
+    for row in &rows {
+        let e: Vec<f64> = row.iter().map(|&e| f64::from(e as f32)).collect();
+        let h = 1.0 / last;
+        let avg: f64 = (0..n - 1)
+            .map(|i| {
+                let (m0, m1) = (i as f64 * h, (i + 1) as f64 * h);
+                let (e0, e1) = (e[i], e[i + 1]);
+                // ∫ (e0 + (e1 − e0)(μ − m0)/h) μ dμ over [m0, m1].
+                let s = (e1 - e0) / h;
+                let c = e0 - s * m0;
+                c * (m1 * m1 - m0 * m0) / 2.0 + s * (m1.powi(3) - m0.powi(3)) / 3.0
+            })
+            .sum();
+        t.push((2.0 * avg) as f32);
+    }
+    let f_avg = fresnel_average_f64(eta);
+    t.push(f_avg as f32);
+    // Light inside the coat, diffusely distributed, escapes with 1 − F_avg(1/η) =
+    // (1 − F_avg(η))/η² (reciprocity of the interface).
+    t.push((1.0 - (1.0 - f_avg) / (eta * eta)) as f32);
+    t
+}
+
+/// The tables of `eta`, built once per process and shared.
+pub fn coat_table_cached(eta: f32) -> Arc<[f32]> {
+    static CACHE: OnceLock<Mutex<HashMap<u32, Arc<[f32]>>>> = OnceLock::new();
+    let cache = CACHE.get_or_init(Default::default);
+    if let Some(t) = cache.lock().expect("coat cache").get(&eta.to_bits()) {
+        return t.clone();
+    }
+    // Built outside the lock: two threads may build the same table, and both are equal.
+    let t: Arc<[f32]> = coat_table(eta).into();
+    cache
+        .lock()
+        .expect("coat cache")
+        .entry(eta.to_bits())
+        .or_insert(t)
+        .clone()
+}
+
+/// A plastic's BSDF over lanes: each lane's coat tables start at `base` in `tables`.
+#[derive(Clone, Copy, Debug)]
+pub struct Plastic<'a, F: Float, const N: usize> {
+    /// The coat's microfacet distribution (ignored in smooth lanes).
+    pub dist: Ggx<F>,
+    /// Lanes whose coat is smooth: a delta lobe.
+    pub smooth: F::Mask,
+    /// The coat's IOR over the outside's.
+    pub eta: F,
+    /// The base's reflectance ρ per channel.
+    pub albedo: Chan<F, N>,
+    /// Every coat table of the scene.
+    pub tables: &'a [f32],
+    /// Each lane's offset into `tables` (a valid offset in every lane).
+    pub base: F::U32,
+}
+
+impl<F: Float, const N: usize> Plastic<'_, F, N> {
+    /// E(μ): the coat's directional reflectance from outside.
+    #[inline(always)]
+    fn e(&self, mu: F) -> F {
+        let smooth = fresnel_dielectric(mu, self.eta);
+        if self.smooth.all() {
+            return smooth;
+        }
+        let last = (GGX_TABLE_SIZE - 1) as f32;
+        let x = unit(mu) * F::splat(last);
+        let y = unit(self.dist.alpha()) * F::splat(last);
+        let (xi, yi) = (
+            x.floor().min(F::splat(last - 1.0)),
+            y.floor().min(F::splat(last - 1.0)),
+        );
+        let (fx, fy) = (x - xi, y - yi);
+        let i = self
+            .base
+            .wrapping_add((yi * F::splat(GGX_TABLE_SIZE as f32) + xi).to_i32_bits());
+        let (one, row) = (F::U32::splat(1), F::U32::splat(GGX_TABLE_SIZE as u32));
+        let t = self.tables;
+        let a = F::gather(t, i);
+        let b = F::gather(t, i.wrapping_add(one));
+        let c = F::gather(t, i.wrapping_add(row));
+        let d = F::gather(t, i.wrapping_add(row).wrapping_add(one));
+        let top = a + (b - a) * fx;
+        let bottom = c + (d - c) * fx;
+        F::select(self.smooth, smooth, top + (bottom - top) * fy)
+    }
+
+    /// E_avg, linear in α (the smooth coat's from its own entry).
+    #[inline(always)]
+    fn e_avg(&self) -> F {
+        let t = self.tables;
+        let smooth = F::gather(t, self.base.wrapping_add(F::U32::splat(SMOOTH_AVG as u32)));
+        if self.smooth.all() {
+            return smooth;
+        }
+        let last = (GGX_TABLE_SIZE - 1) as f32;
+        let y = unit(self.dist.alpha()) * F::splat(last);
+        let yi = y.floor().min(F::splat(last - 1.0));
+        let f = y - yi;
+        let i = self
+            .base
+            .wrapping_add(F::U32::splat(AVG as u32))
+            .wrapping_add(yi.to_i32_bits());
+        let a = F::gather(t, i);
+        let b = F::gather(t, i.wrapping_add(F::U32::splat(1)));
+        F::select(self.smooth, smooth, a + (b - a) * f)
+    }
+
+    /// ρ_eff = ρ(1 − F_in)/(1 − ρF_in) per channel: the base's bounces under the coat.
+    #[inline(always)]
+    fn rho_eff(&self) -> Chan<F, N> {
+        let f_in = F::gather(
+            self.tables,
+            self.base.wrapping_add(F::U32::splat(F_IN as u32)),
+        );
+        let one = F::one();
+        Chan(
+            self.albedo
+                .0
+                .map(|r| r * (one - f_in) / (one - r * f_in).max(F::splat(1e-6))),
+        )
+    }
+
+    /// The probability of sampling the coat's lobe from `wo`: its share of the albedo,
+    /// E(μo) against (1 − E(μo)) times the base's mean ρ_eff.
+    #[inline(always)]
+    fn coat_probability(&self, e_o: F, rho: &Chan<F, N>) -> F {
+        let mean = rho.0.iter().fold(F::zero(), |a, &r| a + r) * F::splat(1.0 / N as f32);
+        let total = e_o + (F::one() - e_o) * mean;
+        F::select(total.gt(F::zero()), e_o / total, F::one())
+    }
+
+    /// The base's lobe: ρ_eff(1 − E(μo))(1 − E(μi))/(π(1 − E_avg)).
+    #[inline(always)]
+    fn base_lobe(&self, rho: &Chan<F, N>, e_o: F, e_i: F) -> Chan<F, N> {
+        let one = F::one();
+        let k = (one - e_o) * (one - e_i)
+            / (F::splat(std::f32::consts::PI) * (one - self.e_avg()).max(F::splat(1e-6)));
+        *rho * k
+    }
+
+    /// The coat's lobe with probability P(coat) (a mirror direction in smooth lanes, a
+    /// visible normal's reflection in rough ones), else a cosine-distributed direction.
+    #[inline(always)]
+    pub fn sample(&self, wo: V3<F>, uc: F, u1: F, u2: F) -> BsdfSample<F, Chan<F, N>> {
+        let zero = F::zero();
+        let rho = self.rho_eff();
+        let e_o = self.e(wo.z);
+        let p = self.coat_probability(e_o, &rho);
+        let coat = uc.lt(p);
+        let h = self.dist.sample_visible_normal(wo, u1, u2);
+        let rough_wi = h * (F::splat(2.0) * wo.dot(h)) - wo;
+        let coat_wi = V3::select(self.smooth, reflect_local(wo), rough_wi);
+        let cosine = crate::sampling::warp::lanes::square_to_cosine_hemisphere(u1, u2);
+        let wi = V3::select(coat, coat_wi, cosine);
+        let ok = wo.z.gt(zero) & wi.z.gt(zero);
+        let specular = self.smooth & coat;
+        // The smooth coat's delta lobe: F(μo)/P(coat), chosen with probability P(coat).
+        let mirror = F::select(p.gt(zero), e_o / p, zero);
+        let pdf_mix = self.pdf_with(wo, wi, p);
+        let f = self.eval_with(wo, wi, &rho, e_o);
+        let w = F::select(ok & pdf_mix.gt(zero), wi.z / pdf_mix, zero);
+        let mut weight = f * w;
+        for c in weight.0.iter_mut() {
+            *c = F::select(specular, F::select(ok, mirror, zero), *c);
+        }
+        BsdfSample {
+            wi,
+            weight,
+            pdf: F::select(ok, F::select(specular, p, pdf_mix), zero),
+            lobe: F::U32::select(
+                specular,
+                F::U32::splat(lobe::SPECULAR_REFLECTION),
+                F::U32::select(
+                    coat,
+                    F::U32::splat(lobe::GLOSSY_REFLECTION),
+                    F::U32::splat(lobe::DIFFUSE_REFLECTION),
+                ),
+            ),
+            eta: F::one(),
+        }
+    }
+
+    /// f(wo, wi) (no cosine): the rough coat's lobe and the base's; a smooth coat's delta
+    /// lobe has no value here.
+    #[inline(always)]
+    pub fn eval(&self, wo: V3<F>, wi: V3<F>) -> Chan<F, N> {
+        let rho = self.rho_eff();
+        self.eval_with(wo, wi, &rho, self.e(wo.z))
+    }
+
+    #[inline(always)]
+    fn eval_with(&self, wo: V3<F>, wi: V3<F>, rho: &Chan<F, N>, e_o: F) -> Chan<F, N> {
+        let zero = F::zero();
+        let (zo, zi) = (wo.z, wi.z);
+        let ok = zo.gt(zero) & zi.gt(zero);
+        let base = self.base_lobe(rho, e_o, self.e(zi));
+        let rough = ok & !self.smooth;
+        let coat = if rough.any() {
+            let h = (wo + wi).normalize();
+            let so = self.dist.stretched_len(wo);
+            let si = self.dist.stretched_len(wi);
+            let v = self.dist.d(h) / (F::splat(2.0) * (so * zi + si * zo));
+            F::select(rough, fresnel_dielectric(wo.dot(h), self.eta) * v, zero)
+        } else {
+            zero
+        };
+        let mut out = base;
+        for c in out.0.iter_mut() {
+            *c = F::select(ok, *c + coat, zero);
+        }
+        out
+    }
+
+    /// The solid-angle density of [`Plastic::sample`] drawing `wi` (the base's lobe only in
+    /// smooth lanes).
+    #[inline(always)]
+    pub fn pdf(&self, wo: V3<F>, wi: V3<F>) -> F {
+        let rho = self.rho_eff();
+        let p = self.coat_probability(self.e(wo.z), &rho);
+        self.pdf_with(wo, wi, p)
+    }
+
+    #[inline(always)]
+    fn pdf_with(&self, wo: V3<F>, wi: V3<F>, p: F) -> F {
+        let zero = F::zero();
+        let ok = wo.z.gt(zero) & wi.z.gt(zero);
+        let cosine = (F::one() - p) * wi.z * F::splat(FRAC_1_PI);
+        let h = (wo + wi).normalize();
+        let vis = self.dist.d(h) / (F::splat(2.0) * (wo.z + self.dist.stretched_len(wo)));
+        let pdf = F::select(self.smooth, cosine, cosine + p * vis);
+        F::select(ok, pdf, zero)
+    }
+}
