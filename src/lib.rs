@@ -12,6 +12,7 @@
 
 pub mod cli;
 pub mod components;
+pub mod energy;
 pub mod files;
 pub mod film;
 pub mod geometry;

@@ -20,106 +20,15 @@
 
 use super::bsdf::{BsdfSample, Chan, fresnel_dielectric, lobe, reflect_local};
 use super::ggx_tables::GGX_TABLE_SIZE;
-use super::microfacet::{Ggx, ggx_albedo_with, unit};
+use super::microfacet::{Ggx, unit};
 use crate::simd::{Float, Mask, UInt, V3};
-use std::collections::HashMap;
 use std::f32::consts::FRAC_1_PI;
-use std::sync::{Arc, Mutex, OnceLock};
 
-/// E(μ, α) on a `GGX_TABLE_SIZE`² grid (row per α), then E_avg(α), then the smooth coat's
-/// E_avg and F_in.
-pub const COAT_TABLE_LEN: usize = GGX_TABLE_SIZE * GGX_TABLE_SIZE + GGX_TABLE_SIZE + 2;
-const AVG: usize = GGX_TABLE_SIZE * GGX_TABLE_SIZE;
-const SMOOTH_AVG: usize = AVG + GGX_TABLE_SIZE;
-const F_IN: usize = SMOOTH_AVG + 1;
+use crate::energy::{AVG, F_IN, SMOOTH_AVG};
+pub use crate::energy::{COAT_TABLE_LEN, coat_table, coat_table_cached};
 
-/// Fresnel reflectance of a smooth dielectric interface in f64 (relative IOR `eta`).
-fn fresnel_f64(cos_i: f64, eta: f64) -> f64 {
-    let c = cos_i.clamp(0.0, 1.0);
-    let cos2_t = (eta * eta - 1.0 + c * c) / (eta * eta);
-    if cos2_t <= 0.0 {
-        return 1.0;
-    }
-    let ct = cos2_t.sqrt();
-    let rp = (eta * c - ct) / (eta * c + ct);
-    let rs = (c - eta * ct) / (c + eta * ct);
-    0.5 * (rp * rp + rs * rs)
-}
-
-/// 2∫F(μ)μ dμ for relative IOR `eta`, by the midpoint rule in x = μ² (F(√x) is smooth but
-/// for the kink at a critical angle, which 4096 nodes resolve to 1e-6).
-fn fresnel_average_f64(eta: f64) -> f64 {
-    let n = 4096;
-    (0..n)
-        .map(|i| fresnel_f64(((i as f64 + 0.5) / n as f64).sqrt(), eta) / n as f64)
-        .sum()
-}
-
-/// The coat tables of IOR `eta` (see [`COAT_TABLE_LEN`]).
-pub fn coat_table(eta: f32) -> Vec<f32> {
-    use rayon::prelude::*;
-    let n = GGX_TABLE_SIZE;
-    let last = (n - 1) as f64;
-    let eta = f64::from(eta);
-    let rows: Vec<Vec<f64>> = (0..n)
-        .into_par_iter()
-        .map(|j| {
-            let alpha = j as f64 / last;
-            (0..n)
-                .map(|i| {
-                    let mu = i as f64 / last;
-                    // A grid half as fine as the committed GGX tables': E enters the albedo
-                    // of a white plastic only as E_true − E_table (see the module's notes).
-                    ggx_albedo_with(mu, alpha, |c| fresnel_f64(c, eta), (512, 128)).min(1.0)
-                })
-                .collect()
-        })
-        .collect();
-    let mut t = Vec::with_capacity(COAT_TABLE_LEN);
-    for row in &rows {
-        t.extend(row.iter().map(|&e| e as f32));
-    }
-    // E_avg of the interpolated E: 2∫E(μ)μ dμ with E linear on each cell, integrated exactly
-    // (and from the f32 values the lookups read).
-    for row in &rows {
-        let e: Vec<f64> = row.iter().map(|&e| f64::from(e as f32)).collect();
-        let h = 1.0 / last;
-        let avg: f64 = (0..n - 1)
-            .map(|i| {
-                let (m0, m1) = (i as f64 * h, (i + 1) as f64 * h);
-                let (e0, e1) = (e[i], e[i + 1]);
-                // ∫ (e0 + (e1 − e0)(μ − m0)/h) μ dμ over [m0, m1].
-                let s = (e1 - e0) / h;
-                let c = e0 - s * m0;
-                c * (m1 * m1 - m0 * m0) / 2.0 + s * (m1.powi(3) - m0.powi(3)) / 3.0
-            })
-            .sum();
-        t.push((2.0 * avg) as f32);
-    }
-    let f_avg = fresnel_average_f64(eta);
-    t.push(f_avg as f32);
-    // Light inside the coat, diffusely distributed, escapes with 1 − F_avg(1/η) =
-    // (1 − F_avg(η))/η² (reciprocity of the interface).
-    t.push((1.0 - (1.0 - f_avg) / (eta * eta)) as f32);
-    t
-}
-
-/// The tables of `eta`, built once per process and shared.
-pub fn coat_table_cached(eta: f32) -> Arc<[f32]> {
-    static CACHE: OnceLock<Mutex<HashMap<u32, Arc<[f32]>>>> = OnceLock::new();
-    let cache = CACHE.get_or_init(Default::default);
-    if let Some(t) = cache.lock().expect("coat cache").get(&eta.to_bits()) {
-        return t.clone();
-    }
-    // Built outside the lock: two threads may build the same table, and both are equal.
-    let t: Arc<[f32]> = coat_table(eta).into();
-    cache
-        .lock()
-        .expect("coat cache")
-        .entry(eta.to_bits())
-        .or_insert(t)
-        .clone()
-}
+// The coat tables share the grid of the GGX energy tables.
+const _: () = assert!(crate::energy::TABLE_SIZE == GGX_TABLE_SIZE);
 
 /// A plastic's BSDF over lanes: each lane's coat tables start at `base` in `tables`.
 #[derive(Clone, Copy, Debug)]

@@ -183,7 +183,7 @@ pub struct Primitives {
     /// Every material of the scene.
     pub materials: Vec<Material>,
     /// The coat tables of the scene's plastics, one per coat IOR
-    /// ([`crate::integrator::coat::coat_table`]).
+    /// ([`crate::energy::coat_table`]).
     pub coat: Vec<f32>,
     /// Each material's offset into `coat` (0 for other materials).
     pub coat_offset: Vec<u32>,

@@ -139,7 +139,7 @@ pub fn gather_primitives(world: &hecs::World) -> Primitives {
                 None => {
                     let o = p.coat.len() as u32;
                     p.coat
-                        .extend_from_slice(&crate::integrator::coat::coat_table_cached(ior));
+                        .extend_from_slice(&crate::energy::coat_table_cached(ior));
                     at.push((ior.to_bits(), o));
                     o
                 }

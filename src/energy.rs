@@ -1,0 +1,171 @@
+//! Energy tables of rough surfaces, in f64: the directional albedo of a GGX lobe by
+//! quadrature (from which `examples/ggx_tables.rs` generates the committed tables of the
+//! conductor's energy compensation), and the coat tables of a plastic, built per coat IOR
+//! when a scene is gathered.
+
+use std::collections::HashMap;
+use std::sync::{Arc, Mutex, OnceLock};
+
+/// The grid size of every energy table: μ and α each on `TABLE_SIZE` points of [0, 1].
+pub const TABLE_SIZE: usize = 32;
+
+/// E(μ, α), the directional albedo of a GGX lobe with F = 1 at incidence cosine μ, in f64:
+/// ∫ D(h)·G2(wo, wi)·|wo·h| / μ dωh over the normals reflecting wo above the surface
+/// (f = D·G2/(4 μo μi), dωi = 4|wo·h| dωh), by the midpoint rule in (cos θh = 1 − t², φ),
+/// a grid dense where narrow lobes are. The generator of the committed tables.
+pub fn ggx_albedo(mu: f64, alpha: f64) -> f64 {
+    ggx_albedo_with(mu, alpha, |_| 1.0, (1024, 256))
+}
+
+/// The directional albedo of a GGX lobe whose microfacets reflect `fresnel(wo·h)`, by the
+/// quadrature of [`ggx_albedo`] on an `nt` × `np` grid in (t, φ), cos θh = 1 − t².
+pub fn ggx_albedo_with(
+    mu: f64,
+    alpha: f64,
+    fresnel: impl Fn(f64) -> f64,
+    (nt, np): (usize, usize),
+) -> f64 {
+    use std::f64::consts::PI;
+    if alpha <= 0.0 {
+        return fresnel(mu);
+    }
+    let mu = mu.clamp(1e-4, 1.0);
+    let wo = [(1.0 - mu * mu).sqrt(), 0.0, mu];
+    let a2 = alpha * alpha;
+    let s = |w: [f64; 3]| (a2 * (w[0] * w[0] + w[1] * w[1]) + w[2] * w[2]).sqrt();
+    let mut e = 0.0;
+    for i in 0..nt {
+        let t = (i as f64 + 0.5) / nt as f64;
+        let cos = 1.0 - t * t;
+        let sin = (1.0 - cos * cos).max(0.0).sqrt();
+        let dcos = 2.0 * t / nt as f64;
+        // wo lies in the xz plane: the integrand is even in φ, so half the circle, twice.
+        for j in 0..np {
+            let phi = (j as f64 + 0.5) / np as f64 * PI;
+            let h = [sin * phi.cos(), sin * phi.sin(), cos];
+            let oh = wo[0] * h[0] + wo[2] * h[2];
+            if oh <= 0.0 {
+                continue;
+            }
+            let wi = [
+                2.0 * oh * h[0] - wo[0],
+                2.0 * oh * h[1],
+                2.0 * oh * h[2] - wo[2],
+            ];
+            if wi[2] <= 0.0 {
+                continue;
+            }
+            let q = (h[0] * h[0] + h[1] * h[1]) / a2 + h[2] * h[2];
+            let d = 1.0 / (PI * a2 * q * q);
+            let g2 = 2.0 * wo[2] * wi[2] / (s(wo) * wi[2] + s(wi) * wo[2]);
+            e += fresnel(oh) * d * g2 * oh / mu * dcos * (2.0 * PI / np as f64);
+        }
+    }
+    e
+}
+
+/// E_avg(α) = 2∫E(μ)μ dμ (midpoint rule, 64 nodes), in f64.
+pub fn ggx_average_albedo(alpha: f64) -> f64 {
+    let n = 64;
+    (0..n)
+        .map(|i| {
+            let mu = (i as f64 + 0.5) / n as f64;
+            2.0 * ggx_albedo(mu, alpha) * mu / n as f64
+        })
+        .sum()
+}
+
+/// E(μ, α) on a `TABLE_SIZE`² grid (row per α), then E_avg(α), then the smooth coat's
+/// E_avg and F_in.
+pub const COAT_TABLE_LEN: usize = TABLE_SIZE * TABLE_SIZE + TABLE_SIZE + 2;
+pub(crate) const AVG: usize = TABLE_SIZE * TABLE_SIZE;
+pub(crate) const SMOOTH_AVG: usize = AVG + TABLE_SIZE;
+pub(crate) const F_IN: usize = SMOOTH_AVG + 1;
+
+/// Fresnel reflectance of a smooth dielectric interface in f64 (relative IOR `eta`).
+fn fresnel_f64(cos_i: f64, eta: f64) -> f64 {
+    let c = cos_i.clamp(0.0, 1.0);
+    let cos2_t = (eta * eta - 1.0 + c * c) / (eta * eta);
+    if cos2_t <= 0.0 {
+        return 1.0;
+    }
+    let ct = cos2_t.sqrt();
+    let rp = (eta * c - ct) / (eta * c + ct);
+    let rs = (c - eta * ct) / (c + eta * ct);
+    0.5 * (rp * rp + rs * rs)
+}
+
+/// 2∫F(μ)μ dμ for relative IOR `eta`, by the midpoint rule in x = μ² (F(√x) is smooth but
+/// for the kink at a critical angle, which 4096 nodes resolve to 1e-6).
+fn fresnel_average_f64(eta: f64) -> f64 {
+    let n = 4096;
+    (0..n)
+        .map(|i| fresnel_f64(((i as f64 + 0.5) / n as f64).sqrt(), eta) / n as f64)
+        .sum()
+}
+
+/// The coat tables of IOR `eta` (see [`COAT_TABLE_LEN`]).
+pub fn coat_table(eta: f32) -> Vec<f32> {
+    use rayon::prelude::*;
+    let n = TABLE_SIZE;
+    let last = (n - 1) as f64;
+    let eta = f64::from(eta);
+    let rows: Vec<Vec<f64>> = (0..n)
+        .into_par_iter()
+        .map(|j| {
+            let alpha = j as f64 / last;
+            (0..n)
+                .map(|i| {
+                    let mu = i as f64 / last;
+                    // A grid half as fine as the committed GGX tables': E enters the albedo
+                    // of a white plastic only as E_true − E_table (see the module's notes).
+                    ggx_albedo_with(mu, alpha, |c| fresnel_f64(c, eta), (512, 128)).min(1.0)
+                })
+                .collect()
+        })
+        .collect();
+    let mut t = Vec::with_capacity(COAT_TABLE_LEN);
+    for row in &rows {
+        t.extend(row.iter().map(|&e| e as f32));
+    }
+    // E_avg of the interpolated E: 2∫E(μ)μ dμ with E linear on each cell, integrated exactly
+    // (and from the f32 values the lookups read).
+    for row in &rows {
+        let e: Vec<f64> = row.iter().map(|&e| f64::from(e as f32)).collect();
+        let h = 1.0 / last;
+        let avg: f64 = (0..n - 1)
+            .map(|i| {
+                let (m0, m1) = (i as f64 * h, (i + 1) as f64 * h);
+                let (e0, e1) = (e[i], e[i + 1]);
+                // ∫ (e0 + (e1 − e0)(μ − m0)/h) μ dμ over [m0, m1].
+                let s = (e1 - e0) / h;
+                let c = e0 - s * m0;
+                c * (m1 * m1 - m0 * m0) / 2.0 + s * (m1.powi(3) - m0.powi(3)) / 3.0
+            })
+            .sum();
+        t.push((2.0 * avg) as f32);
+    }
+    let f_avg = fresnel_average_f64(eta);
+    t.push(f_avg as f32);
+    // Light inside the coat, diffusely distributed, escapes with 1 − F_avg(1/η) =
+    // (1 − F_avg(η))/η² (reciprocity of the interface).
+    t.push((1.0 - (1.0 - f_avg) / (eta * eta)) as f32);
+    t
+}
+
+/// The tables of `eta`, built once per process and shared.
+pub fn coat_table_cached(eta: f32) -> Arc<[f32]> {
+    static CACHE: OnceLock<Mutex<HashMap<u32, Arc<[f32]>>>> = OnceLock::new();
+    let cache = CACHE.get_or_init(Default::default);
+    if let Some(t) = cache.lock().expect("coat cache").get(&eta.to_bits()) {
+        return t.clone();
+    }
+    // Built outside the lock: two threads may build the same table, and both are equal.
+    let t: Arc<[f32]> = coat_table(eta).into();
+    cache
+        .lock()
+        .expect("coat cache")
+        .entry(eta.to_bits())
+        .or_insert(t)
+        .clone()
+}
