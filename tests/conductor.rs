@@ -5,7 +5,7 @@
 
 mod common;
 use common::furnace::{sphere_mean, sphere_mean_in};
-use common::render::{image, mean_where};
+use common::render::z_between;
 use prism::integrator::microfacet::ggx_average_albedo;
 
 /// The geometry the furnace relies on: a black sphere removes exactly its disc's share of
@@ -126,20 +126,10 @@ Scene(
         )
     };
     for alpha in [0.08f32, 0.4] {
-        let stats = |extra: &str| {
-            let v: Vec<f64> = (0..8)
-                .map(|s| {
-                    let img = image(&scene(alpha, 100 + s, extra));
-                    mean_where(&img, 0, |_, _| true)
-                })
-                .collect();
-            let mean = v.iter().sum::<f64>() / v.len() as f64;
-            let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (v.len() - 1) as f64;
-            (mean, var / v.len() as f64)
-        };
-        let (a, va) = stats("");
-        let (b, vb) = stats(", integrator: (light_sampling: Path)");
-        let z = (a - b) / (va + vb).sqrt();
+        let (a, b, z) = z_between(
+            |s| scene(alpha, s, ""),
+            |s| scene(alpha, s, ", integrator: (light_sampling: Path)"),
+        );
         assert!(a > 0.0 && b > 0.0);
         assert!(
             z.abs() < 4.0,

@@ -6,7 +6,8 @@
 mod common;
 use common::chi2::Chi2;
 use common::furnace::sphere_mean;
-use common::render::{image, mean_where};
+use common::quadrature::simpson;
+use common::render::z_between;
 use glam::Vec3;
 use prism::integrator::bsdf::{Chan, lobe};
 use prism::integrator::coat::{Plastic, coat_table_cached};
@@ -126,22 +127,8 @@ fn smooth_plastic_is_the_closed_form() {
         let rp = (eta * c - ct) / (eta * c + ct);
         0.5 * (rs * rs + rp * rp)
     };
-    // 2∫F(μ)μ dμ = ∫F(√x) dx: Simpson's rule on 20 000 intervals.
-    let n = 20_000;
-    let avg: f64 = (0..=n)
-        .map(|i| {
-            let x = i as f64 / n as f64;
-            let w = if i == 0 || i == n {
-                1.0
-            } else if i % 2 == 1 {
-                4.0
-            } else {
-                2.0
-            };
-            w * fresnel(x.sqrt(), eta)
-        })
-        .sum::<f64>()
-        / (3.0 * n as f64);
+    // 2∫F(μ)μ dμ = ∫F(√x) dx.
+    let avg = simpson(|x| fresnel(x.sqrt(), eta), 0.0, 1.0, 20_000);
     let f_in = 1.0 - (1.0 - avg) / (eta * eta);
     let t = coat_table_cached(eta as f32);
     let rho = [0.9f32, 0.5, 0.1];
@@ -245,17 +232,10 @@ Scene(
         "Plastic(albedo: Rgb(0.7, 0.2, 0.1), alpha: 0.1)",
         "Plastic(albedo: Rgb(0.2, 0.3, 0.7), ior: 1.3, roughness: 0.7)",
     ] {
-        let stats = |extra: &str| {
-            let v: Vec<f64> = (0..8)
-                .map(|s| mean_where(&image(&scene(m, 100 + s, extra)), 0, |_, _| true))
-                .collect();
-            let mean = v.iter().sum::<f64>() / v.len() as f64;
-            let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (v.len() - 1) as f64;
-            (mean, var / v.len() as f64)
-        };
-        let (a, va) = stats("");
-        let (b, vb) = stats(", integrator: (light_sampling: Path)");
-        let z = (a - b) / (va + vb).sqrt();
+        let (a, b, z) = z_between(
+            |s| scene(m, s, ""),
+            |s| scene(m, s, ", integrator: (light_sampling: Path)"),
+        );
         assert!(a > 0.0 && b > 0.0);
         assert!(z.abs() < 4.0, "{m}: MIS {a} vs BSDF only {b}, z = {z}");
     }

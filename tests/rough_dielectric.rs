@@ -5,7 +5,7 @@
 
 mod common;
 use common::furnace::sphere_mean_in;
-use common::render::{image, mean_where};
+use common::render::z_between;
 
 /// A sphere of η 1.5 in a white furnace, paths up to 256 bounces. Single scattering among
 /// microfacets only loses energy, so the disc's mean is at most 1 (plus noise), falling as α
@@ -50,16 +50,6 @@ Scene(
     )
 }
 
-/// Mean of channel 0 over 8 seeds, and the variance of that mean.
-fn seeds_mean(scene: impl Fn(u32) -> String) -> (f64, f64) {
-    let v: Vec<f64> = (0..8)
-        .map(|s| mean_where(&image(&scene(100 + s)), 0, |_, _| true))
-        .collect();
-    let mean = v.iter().sum::<f64>() / v.len() as f64;
-    let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (v.len() - 1) as f64;
-    (mean, var / v.len() as f64)
-}
-
 /// Light samples at rough glass, on both sides of the interface, weighted by MIS against
 /// the BSDF's samples, give the image BSDF sampling alone gives (z-test over 8 seeds each);
 /// with a scattering medium inside the ball, shadow rays through the interface start in it.
@@ -68,10 +58,10 @@ fn light_sampling_and_bsdf_sampling_agree_on_rough_glass() {
     let fog = r#", medium: (sigma_a: Rgb(0.1, 0.1, 0.1), sigma_s: Rgb(0.6, 0.6, 0.6), g: 0.3)"#;
     for (alpha, inside) in [(0.1f32, ""), (0.4, ""), (0.3, fog)] {
         let m = format!("Dielectric(ior: Constant(1.5), alpha: {alpha})");
-        let (a, va) = seeds_mean(|s| lit_ball(&m, inside, s, ""));
-        let (b, vb) =
-            seeds_mean(|s| lit_ball(&m, inside, s, ", integrator: (light_sampling: Path)"));
-        let z = (a - b) / (va + vb).sqrt();
+        let (a, b, z) = z_between(
+            |s| lit_ball(&m, inside, s, ""),
+            |s| lit_ball(&m, inside, s, ", integrator: (light_sampling: Path)"),
+        );
         assert!(a > 0.0 && b > 0.0);
         assert!(
             z.abs() < 4.0,
@@ -84,10 +74,10 @@ fn light_sampling_and_bsdf_sampling_agree_on_rough_glass() {
 /// rough one takes light samples, the smooth one cannot), z-test over 8 seeds each.
 #[test]
 fn nearly_smooth_agrees_with_smooth_glass() {
-    let (a, va) = seeds_mean(|s| lit_ball("Dielectric(ior: Constant(1.5))", "", s, ""));
-    let (b, vb) =
-        seeds_mean(|s| lit_ball("Dielectric(ior: Constant(1.5), alpha: 0.002)", "", s, ""));
-    let z = (a - b) / (va + vb).sqrt();
+    let (a, b, z) = z_between(
+        |s| lit_ball("Dielectric(ior: Constant(1.5))", "", s, ""),
+        |s| lit_ball("Dielectric(ior: Constant(1.5), alpha: 0.002)", "", s, ""),
+    );
     assert!(z.abs() < 4.0, "smooth {a} vs α 0.002 {b}, z = {z}");
 }
 
@@ -96,9 +86,10 @@ fn nearly_smooth_agrees_with_smooth_glass() {
 #[test]
 fn dispersive_rough_glass_agrees_with_bsdf_sampling() {
     let m = "Dielectric(ior: Cauchy(a: 1.6, b: 0.02), alpha: 0.2)";
-    let (a, va) = seeds_mean(|s| lit_ball(m, "", s, ""));
-    let (b, vb) = seeds_mean(|s| lit_ball(m, "", s, ", integrator: (light_sampling: Path)"));
+    let (a, b, z) = z_between(
+        |s| lit_ball(m, "", s, ""),
+        |s| lit_ball(m, "", s, ", integrator: (light_sampling: Path)"),
+    );
     assert!(a.is_finite() && b.is_finite() && a > 0.0);
-    let z = (a - b) / (va + vb).sqrt();
     assert!(z.abs() < 4.0, "MIS {a} vs BSDF only {b}, z = {z}");
 }

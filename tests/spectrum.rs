@@ -4,6 +4,7 @@
 mod common;
 
 use common::chi2::{Chi2, uniform_1d};
+use common::quadrature::simpson;
 use glam::{Vec2, Vec3};
 use prism::spectrum::rgb2spec::{TABLE_RES, Z_DARK, table_cell, table_cell_rgb, z_node};
 use prism::spectrum::*;
@@ -397,21 +398,12 @@ fn cauchy_and_constant_models() {
 #[test]
 fn visible_pdf_integrates_to_one() {
     // Simpson's rule at 0.1 nm.
-    let n = 4700;
-    let h = (LAMBDA_MAX - LAMBDA_MIN) as f64 / n as f64;
-    let mut s = 0.0;
-    for i in 0..=n {
-        let w = if i == 0 || i == n {
-            1.0
-        } else if i % 2 == 1 {
-            4.0
-        } else {
-            2.0
-        };
-        let l = f64::from(LAMBDA_MIN) + i as f64 * h;
-        s += w * f64::from(Wavelengths::visible_pdf(l as f32));
-    }
-    let integral = s * h / 3.0;
+    let integral = simpson(
+        |l| f64::from(Wavelengths::visible_pdf(l as f32)),
+        f64::from(LAMBDA_MIN),
+        f64::from(LAMBDA_MAX),
+        4700,
+    );
     assert!((integral - 1.0).abs() < 1e-5, "{integral}");
     assert_eq!(Wavelengths::visible_pdf(LAMBDA_MIN - 1.0), 0.0);
     assert_eq!(Wavelengths::visible_pdf(LAMBDA_MAX + 1.0), 0.0);

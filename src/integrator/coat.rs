@@ -20,7 +20,7 @@
 
 use super::bsdf::{BsdfSample, Chan, fresnel_dielectric, lobe, reflect_local};
 use super::ggx_tables::GGX_TABLE_SIZE;
-use super::microfacet::{Ggx, unit};
+use super::microfacet::{Ggx, table_bilinear, table_linear};
 use crate::simd::{Float, Mask, UInt, V3};
 use std::f32::consts::FRAC_1_PI;
 
@@ -55,26 +55,8 @@ impl<F: Float, const N: usize> Plastic<'_, F, N> {
         if self.smooth.all() {
             return smooth;
         }
-        let last = (GGX_TABLE_SIZE - 1) as f32;
-        let x = unit(mu) * F::splat(last);
-        let y = unit(self.dist.alpha()) * F::splat(last);
-        let (xi, yi) = (
-            x.floor().min(F::splat(last - 1.0)),
-            y.floor().min(F::splat(last - 1.0)),
-        );
-        let (fx, fy) = (x - xi, y - yi);
-        let i = self
-            .base
-            .wrapping_add((yi * F::splat(GGX_TABLE_SIZE as f32) + xi).to_i32_bits());
-        let (one, row) = (F::U32::splat(1), F::U32::splat(GGX_TABLE_SIZE as u32));
-        let t = self.tables;
-        let a = F::gather(t, i);
-        let b = F::gather(t, i.wrapping_add(one));
-        let c = F::gather(t, i.wrapping_add(row));
-        let d = F::gather(t, i.wrapping_add(row).wrapping_add(one));
-        let top = a + (b - a) * fx;
-        let bottom = c + (d - c) * fx;
-        F::select(self.smooth, smooth, top + (bottom - top) * fy)
+        let rough = table_bilinear(self.tables, self.base, mu, self.dist.alpha());
+        F::select(self.smooth, smooth, rough)
     }
 
     /// E_avg, linear in α (the smooth coat's from its own entry).
@@ -85,17 +67,8 @@ impl<F: Float, const N: usize> Plastic<'_, F, N> {
         if self.smooth.all() {
             return smooth;
         }
-        let last = (GGX_TABLE_SIZE - 1) as f32;
-        let y = unit(self.dist.alpha()) * F::splat(last);
-        let yi = y.floor().min(F::splat(last - 1.0));
-        let f = y - yi;
-        let i = self
-            .base
-            .wrapping_add(F::U32::splat(AVG as u32))
-            .wrapping_add(yi.to_i32_bits());
-        let a = F::gather(t, i);
-        let b = F::gather(t, i.wrapping_add(F::U32::splat(1)));
-        F::select(self.smooth, smooth, a + (b - a) * f)
+        let row = self.base.wrapping_add(F::U32::splat(AVG as u32));
+        F::select(self.smooth, smooth, table_linear(t, row, self.dist.alpha()))
     }
 
     /// ρ_eff = ρ(1 − F_in)/(1 − ρF_in) per channel: the base's bounces under the coat.

@@ -2,7 +2,7 @@
 //! (a class no lane needs is skipped), light samples at the lanes whose BSDF has a density
 //! (diffuse, rough conductors and rough dielectrics), then Russian roulette.
 
-use super::bsdf::{Dielectric, Diffuse, Frame, Mirror, Mode};
+use super::bsdf::{BsdfSample, Dielectric, Diffuse, Frame, Mirror, Mode};
 use super::ctx::{Ctx, DIM_BOUNCE, DIMS_PER_BOUNCE};
 use super::light::Glossy;
 use super::microfacet::{Ggx, RoughDielectric, SMOOTH_ALPHA};
@@ -99,18 +99,7 @@ pub(super) fn scatter<
             ctx.sampler
                 .get_2d_lanes::<F>(st.pixel, st.sample, dim.wrapping_add(U::<F>::splat(4)));
         let bs = conductor.sample(wo_l, ux, uy);
-        let smooth = cm & conductor.smooth;
-        let wi = frame.to_world(bs.wi).normalize();
-        // A rough reflection about a tilted shading normal can point into the geometric back
-        // side: absorbed, as for diffuse lanes. A smooth one is kept above, as a mirror's.
-        let ok = cm & bs.pdf.gt(F::zero()) & (smooth | gdot(wi, sf.nf).gt(F::zero()));
-        st.alive = st.alive.and_not(cm.and_not(ok));
-        st.beta = select_c(ok, st.beta * bs.weight, st.beta);
-        st.prev_pdf = F::select(ok, bs.pdf, st.prev_pdf);
-        st.specular = st.specular.and_not(ok) | (ok & smooth);
-        st.o = V3::select(ok, up, st.o);
-        st.d = V3::select(ok, V3::select(smooth, reflect_above(wi, sf.nf), wi), st.d);
-        scattered |= ok;
+        scattered |= reflected(st, cm, &bs, cm & conductor.smooth, &frame, sf, up);
     }
     if pm.any() {
         let uc =
@@ -120,18 +109,7 @@ pub(super) fn scatter<
             ctx.sampler
                 .get_2d_lanes::<F>(st.pixel, st.sample, dim.wrapping_add(U::<F>::splat(4)));
         let bs = sf.plastic(glossy.coat).sample(wo_l, uc, ux, uy);
-        let smooth = pm & bs.is_specular();
-        let wi = frame.to_world(bs.wi).normalize();
-        // As for conductors: a rough or diffuse direction into the geometric back side is
-        // absorbed, a smooth coat's mirror direction is kept above.
-        let ok = pm & bs.pdf.gt(F::zero()) & (smooth | gdot(wi, sf.nf).gt(F::zero()));
-        st.alive = st.alive.and_not(pm.and_not(ok));
-        st.beta = select_c(ok, st.beta * bs.weight, st.beta);
-        st.prev_pdf = F::select(ok, bs.pdf, st.prev_pdf);
-        st.specular = st.specular.and_not(ok) | (ok & smooth);
-        st.o = V3::select(ok, up, st.o);
-        st.d = V3::select(ok, V3::select(smooth, reflect_above(wi, sf.nf), wi), st.d);
-        scattered |= ok;
+        scattered |= reflected(st, pm, &bs, pm & bs.is_specular(), &frame, sf, up);
     }
     if mm.any() {
         let bs = Mirror { tint: sf.color }.sample(wo_l);
@@ -200,6 +178,31 @@ pub(super) fn scatter<
     }
     st.prev_p = V3::select(scattered, sf.p, st.prev_p);
     roulette::russian_roulette(ctx, st, scattered, dim.wrapping_add(U::<F>::splat(6)));
+}
+
+/// Takes the reflection `bs` sampled at the lanes `m` (a delta lobe in `smooth`), leaving
+/// from `up`; returns the lanes that scattered. A rough or diffuse direction about a tilted
+/// shading normal can point into the geometric back side: absorbed, as for diffuse lanes. A
+/// smooth one is kept above, as a mirror's.
+#[inline(always)]
+fn reflected<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize>(
+    st: &mut Paths<F, T, N>,
+    m: M<F>,
+    bs: &BsdfSample<F, C<F, N>>,
+    smooth: M<F>,
+    frame: &Frame<F>,
+    sf: &Surface<F, N>,
+    up: V3<F>,
+) -> M<F> {
+    let wi = frame.to_world(bs.wi).normalize();
+    let ok = m & bs.pdf.gt(F::zero()) & (smooth | gdot(wi, sf.nf).gt(F::zero()));
+    st.alive = st.alive.and_not(m.and_not(ok));
+    st.beta = select_c(ok, st.beta * bs.weight, st.beta);
+    st.prev_pdf = F::select(ok, bs.pdf, st.prev_pdf);
+    st.specular = st.specular.and_not(ok) | (ok & smooth);
+    st.o = V3::select(ok, up, st.o);
+    st.d = V3::select(ok, V3::select(smooth, reflect_above(wi, sf.nf), wi), st.d);
+    ok
 }
 
 /// The relative IOR (transmitted over incident) of the dielectric lanes `em` at each lane's

@@ -502,9 +502,10 @@ pub(crate) fn unit<F: Float>(x: F) -> F {
     F::select(x.gt(F::zero()), x.min(F::one()), F::zero())
 }
 
-/// E(μ, α) from the table, bilinear, μ and α clamped to [0, 1].
+/// A `GGX_TABLE_SIZE`² table of rows per α, starting at `base` in `t`, at (μ, α): bilinear,
+/// μ and α clamped to [0, 1].
 #[inline(always)]
-pub fn ggx_albedo_lanes<F: Float>(mu: F, alpha: F) -> F {
+pub(crate) fn table_bilinear<F: Float>(t: &[f32], base: F::U32, mu: F, alpha: F) -> F {
     let last = (GGX_TABLE_SIZE - 1) as f32;
     let x = unit(mu) * F::splat(last);
     let y = unit(alpha) * F::splat(last);
@@ -513,10 +514,9 @@ pub fn ggx_albedo_lanes<F: Float>(mu: F, alpha: F) -> F {
         y.floor().min(F::splat(last - 1.0)),
     );
     let (fx, fy) = (x - xi, y - yi);
-    let i = (yi * F::splat(GGX_TABLE_SIZE as f32) + xi).to_i32_bits();
+    let i = base.wrapping_add((yi * F::splat(GGX_TABLE_SIZE as f32) + xi).to_i32_bits());
     let one = F::U32::splat(1);
     let row = F::U32::splat(GGX_TABLE_SIZE as u32);
-    let t = GGX_E.as_flattened();
     let a = F::gather(t, i);
     let b = F::gather(t, i.wrapping_add(one));
     let c = F::gather(t, i.wrapping_add(row));
@@ -526,17 +526,30 @@ pub fn ggx_albedo_lanes<F: Float>(mu: F, alpha: F) -> F {
     top + (bottom - top) * fy
 }
 
-/// E_avg(α) from the table, linear, α clamped to [0, 1].
+/// A `GGX_TABLE_SIZE` row over α, starting at `base` in `t`, at α: linear, α clamped to
+/// [0, 1].
 #[inline(always)]
-pub fn ggx_average_albedo_lanes<F: Float>(alpha: F) -> F {
+pub(crate) fn table_linear<F: Float>(t: &[f32], base: F::U32, alpha: F) -> F {
     let last = (GGX_TABLE_SIZE - 1) as f32;
     let y = unit(alpha) * F::splat(last);
     let yi = y.floor().min(F::splat(last - 1.0));
     let f = y - yi;
-    let i = yi.to_i32_bits();
-    let a = F::gather(&GGX_E_AVG, i);
-    let b = F::gather(&GGX_E_AVG, i.wrapping_add(F::U32::splat(1)));
+    let i = base.wrapping_add(yi.to_i32_bits());
+    let a = F::gather(t, i);
+    let b = F::gather(t, i.wrapping_add(F::U32::splat(1)));
     a + (b - a) * f
+}
+
+/// E(μ, α) from the table, bilinear, μ and α clamped to [0, 1].
+#[inline(always)]
+pub fn ggx_albedo_lanes<F: Float>(mu: F, alpha: F) -> F {
+    table_bilinear(GGX_E.as_flattened(), F::U32::splat(0), mu, alpha)
+}
+
+/// E_avg(α) from the table, linear, α clamped to [0, 1].
+#[inline(always)]
+pub fn ggx_average_albedo_lanes<F: Float>(alpha: F) -> F {
+    table_linear(&GGX_E_AVG, F::U32::splat(0), alpha)
 }
 
 pub use crate::energy::{ggx_albedo, ggx_albedo_with, ggx_average_albedo};

@@ -3,4 +3,5 @@
 
 pub mod chi2;
 pub mod furnace;
+pub mod quadrature;
 pub mod render;

@@ -55,3 +55,21 @@ pub fn mean_where(img: &Image, c: usize, keep: impl Fn(u32, u32) -> bool) -> f64
     assert!(n > 0, "no pixel selected");
     s / n as f64
 }
+
+/// The image mean of channel 0 over 8 seeds (100 to 107) of `scene(seed)`, and the variance
+/// of that mean.
+pub fn seeds_mean(scene: impl Fn(u32) -> String) -> (f64, f64) {
+    let v: Vec<f64> = (0..8)
+        .map(|s| mean_where(&image(&scene(100 + s)), 0, |_, _| true))
+        .collect();
+    let mean = v.iter().sum::<f64>() / v.len() as f64;
+    let var = v.iter().map(|x| (x - mean).powi(2)).sum::<f64>() / (v.len() - 1) as f64;
+    (mean, var / v.len() as f64)
+}
+
+/// Two estimators of the same image, over 8 seeds each: their means and the z-score of their
+/// difference.
+pub fn z_between(a: impl Fn(u32) -> String, b: impl Fn(u32) -> String) -> (f64, f64, f64) {
+    let ((ma, va), (mb, vb)) = (seeds_mean(a), seeds_mean(b));
+    (ma, mb, (ma - mb) / (va + vb).sqrt())
+}
