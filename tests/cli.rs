@@ -672,6 +672,18 @@ fn errors_about_entities_after_parsing_carry_their_position() {
         ),
         (
             ball,
+            "material: Diffuse(albedo: Rgb(0.5, 0.5, 0.5)), texture: (roughness: Checker(a: 0.1, b: 0.2, size: 0.5))",
+            "Checker(a: 0.1, b: 0.2",
+            "entity \"ball\": field `texture.roughness`: a roughness texture needs a Conductor",
+        ),
+        (
+            ball,
+            "material: Diffuse(albedo: Rgb(0.5, 0.5, 0.5)), texture: (roughness: Checker(a: 0.1, b: 1.2, size: 0.5))",
+            "1.2, size",
+            "entity \"ball\": field `b`: must be in [0, 1], got 1.2",
+        ),
+        (
+            ball,
             "material: Dielectric(ior: Constant(1.5), roughness: 1.2)",
             "1.2)",
             "entity \"ball\": field `material.roughness`: must be in [0, 1], got 1.2",
@@ -1027,4 +1039,48 @@ fn docs_cli_names_every_option_and_set_key() {
             }
         }
     }
+}
+
+/// An anisotropic roughness runs along ∂p/∂u: a mesh without UVs has none, and is refused at
+/// the roughness, with its position; the same mesh with UVs renders.
+#[test]
+fn anisotropy_needs_uvs_on_a_mesh() {
+    let d = tempfile::tempdir().unwrap();
+    let tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+    write(d.path(), "bare.obj", &format!("{tri}f 1 2 3\n"));
+    write(
+        d.path(),
+        "uv.obj",
+        &format!("{tri}vt 0 0\nvt 1 0\nvt 0 1\nf 1/1 2/2 3/3\n"),
+    );
+    let scene = |mesh: &str| {
+        GOOD.replace(
+            "shape: Sphere(center: (0.0, 0.0, 0.0), radius: 1.0),\n         material: Diffuse(albedo: Rgb(0.5, 0.5, 0.5))",
+            &format!(
+                "shape: Mesh(path: \"{mesh}\"), material: Conductor(metal: Ni, alpha: (0.05, 0.4))"
+            ),
+        )
+    };
+    let text = scene("bare.obj");
+    let at = text.find("(0.05").unwrap();
+    let line = text[..at].matches('\n').count() + 1;
+    let col = at - text[..at].rfind('\n').map_or(0, |i| i + 1) + 1;
+    let bad = write(d.path(), "bare.ron", &text);
+    let err = fails(&["render", bad.to_str().unwrap()]);
+    let want = format!("bare.ron:{line}:{col}: entity \"ball\": field `material.alpha`");
+    assert!(
+        err.contains(&want) && err.contains("no UVs"),
+        "{err}\nwanted: {want}"
+    );
+    let good = write(d.path(), "uv.ron", &scene("uv.obj"));
+    let out = prism()
+        .args(["render", good.to_str().unwrap(), "--quiet", "-o"])
+        .arg(d.path().join("uv.png"))
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
 }

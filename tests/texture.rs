@@ -622,6 +622,7 @@ fn texture_applies_scale_and_offset_before_lookup() {
             wrap: Wrap::Repeat,
         }),
         normal_map: None,
+        roughness: None,
         scale: Vec2::new(2.0, 1.0),
         offset: Vec2::new(0.125, 0.0),
     };

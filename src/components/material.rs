@@ -40,16 +40,16 @@ pub enum Material {
     Dielectric {
         /// Refractive index of the glass as a function of wavelength.
         ior: IorModel,
-        /// GGX roughness α (isotropic), in [0, 1]; 0 is smooth.
-        alpha: f32,
+        /// GGX roughness α, each axis in [0, 1]; 0 is smooth.
+        alpha: Alpha,
     },
     /// A metal: GGX microfacet reflection with a conductor's Fresnel term; a mirror weighted
     /// by that term when `alpha` is below [`crate::integrator::microfacet::SMOOTH_ALPHA`].
     Conductor {
         /// What the Fresnel term is made of.
         ior: ConductorIor,
-        /// GGX roughness α (isotropic), in [0, 1].
-        alpha: f32,
+        /// GGX roughness α, each axis in [0, 1].
+        alpha: Alpha,
         /// Restore the energy of light scattered among microfacets (Kulla & Conty 2017).
         multiscatter: bool,
     },
@@ -61,8 +61,8 @@ pub enum Material {
         albedo: Vec3,
         /// The coat's refractive index, in [1, 3].
         ior: f32,
-        /// The coat's GGX roughness α (isotropic), in [0, 1]; 0 is smooth.
-        alpha: f32,
+        /// The coat's GGX roughness α, each axis in [0, 1]; 0 is smooth.
+        alpha: Alpha,
     },
     /// An area emitter of constant radiance: `emission` is its linear sRGB colour, `spectrum`
     /// what spectral transport evaluates.
@@ -76,6 +76,61 @@ pub enum Material {
     },
     /// No surface at all: the boundary of a medium, crossed without scattering.
     Boundary,
+}
+
+/// A GGX roughness: α along the surface's tangent ∂p/∂u (`x`) and along its bitangent (`y`),
+/// equal for an isotropic surface.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Alpha {
+    /// α along the tangent.
+    pub x: f32,
+    /// α along the bitangent.
+    pub y: f32,
+}
+
+impl Alpha {
+    /// Smooth: α = 0.
+    pub const ZERO: Alpha = Alpha { x: 0.0, y: 0.0 };
+
+    /// The same α along both axes.
+    pub const fn iso(a: f32) -> Self {
+        Alpha { x: a, y: a }
+    }
+
+    /// Whether the two axes differ: the BSDF then needs the surface's tangent.
+    pub fn is_anisotropic(&self) -> bool {
+        self.x != self.y
+    }
+
+    /// Whether either axis is rough.
+    pub fn is_rough(&self) -> bool {
+        self.x.max(self.y) > 0.0
+    }
+
+    /// The same anisotropy with √(αx·αy) = `mean`: how a roughness texture's value applies
+    /// to an anisotropic material.
+    pub fn with_mean(&self, mean: f32) -> Self {
+        let m = (self.x * self.y).sqrt();
+        if m > 0.0 && self.is_anisotropic() {
+            Alpha {
+                x: self.x * mean / m,
+                y: self.y * mean / m,
+            }
+        } else {
+            Alpha::iso(mean)
+        }
+    }
+}
+
+/// `0.2`, or `(0.05, 0.4)` when anisotropic: the scene format's syntax.
+impl std::fmt::Display for Alpha {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        if self.is_anisotropic() {
+            write!(f, "({:?}, {:?})", self.x, self.y)
+        } else {
+            write!(f, "{:?}", self.x)
+        }
+    }
 }
 
 /// A conductor's Fresnel term.
@@ -147,6 +202,29 @@ impl Material {
             m @ (Material::Dielectric { .. } | Material::Boundary | Material::Conductor { .. }) => {
                 m
             }
+        }
+    }
+
+    /// The material with a roughness texture's value `r` applied (α = r², or for an
+    /// anisotropic material √(αx·αy) = r²); materials without a roughness are unchanged.
+    #[inline]
+    pub fn roughened(mut self, r: f32) -> Material {
+        if let Material::Conductor { alpha, .. }
+        | Material::Dielectric { alpha, .. }
+        | Material::Plastic { alpha, .. } = &mut self
+        {
+            *alpha = alpha.with_mean(r * r);
+        }
+        self
+    }
+
+    /// The GGX roughness of a Conductor, Dielectric or Plastic.
+    pub fn alpha(&self) -> Option<Alpha> {
+        match self {
+            Material::Conductor { alpha, .. }
+            | Material::Dielectric { alpha, .. }
+            | Material::Plastic { alpha, .. } => Some(*alpha),
+            _ => None,
         }
     }
 
@@ -225,8 +303,8 @@ impl std::fmt::Display for Material {
                         IorModel::Sellmeier4 { b, c } => format!("Sellmeier4(b: {b:?}, c: {c:?})"),
                     },
                 };
-                if *alpha > 0.0 {
-                    write!(f, "Dielectric(ior: {ior}, alpha: {alpha:?})")
+                if alpha.is_rough() {
+                    write!(f, "Dielectric(ior: {ior}, alpha: {alpha})")
                 } else {
                     write!(f, "Dielectric(ior: {ior})")
                 }
@@ -247,7 +325,7 @@ impl std::fmt::Display for Material {
                         write!(f, "Conductor(reflectance: {}", Rgb(*r))?
                     }
                 }
-                write!(f, ", alpha: {alpha:?}")?;
+                write!(f, ", alpha: {alpha}")?;
                 if !multiscatter {
                     f.write_str(", multiscatter: false")?;
                 }
@@ -255,8 +333,8 @@ impl std::fmt::Display for Material {
             }
             Material::Plastic { albedo, ior, alpha } => {
                 write!(f, "Plastic(albedo: {}, ior: {ior:?}", Rgb(*albedo))?;
-                if *alpha > 0.0 {
-                    write!(f, ", alpha: {alpha:?}")?;
+                if alpha.is_rough() {
+                    write!(f, ", alpha: {alpha}")?;
                 }
                 f.write_str(")")
             }
@@ -305,14 +383,14 @@ mod tests {
             (
                 Material::Dielectric {
                     ior: IorModel::Constant(1.5),
-                    alpha: 0.0,
+                    alpha: Alpha::iso(0.0),
                 },
                 "Dielectric(ior: Constant(1.5))",
             ),
             (
                 Material::Dielectric {
                     ior: IorModel::Constant(1.5),
-                    alpha: 0.25,
+                    alpha: Alpha::iso(0.25),
                 },
                 "Dielectric(ior: Constant(1.5), alpha: 0.25)",
             ),
@@ -320,7 +398,7 @@ mod tests {
                 Material::Plastic {
                     albedo: Vec3::new(0.8, 0.1, 0.1),
                     ior: 1.5,
-                    alpha: 0.0,
+                    alpha: Alpha::iso(0.0),
                 },
                 "Plastic(albedo: Rgb(0.8, 0.1, 0.1), ior: 1.5)",
             ),
@@ -328,21 +406,21 @@ mod tests {
                 Material::Plastic {
                     albedo: Vec3::ONE,
                     ior: 1.4,
-                    alpha: 0.09,
+                    alpha: Alpha::iso(0.09),
                 },
                 "Plastic(albedo: Rgb(1.0, 1.0, 1.0), ior: 1.4, alpha: 0.09)",
             ),
             (
                 Material::Dielectric {
                     ior: IorModel::Cauchy { a: 1.5, b: 0.004 },
-                    alpha: 0.0,
+                    alpha: Alpha::iso(0.0),
                 },
                 "Dielectric(ior: Cauchy(a: 1.5, b: 0.004))",
             ),
             (
                 Material::Dielectric {
                     ior: IorPreset::Water.model(),
-                    alpha: 0.0,
+                    alpha: Alpha::iso(0.0),
                 },
                 "Dielectric(ior: Preset(Water))",
             ),
@@ -367,7 +445,7 @@ mod tests {
             (
                 Material::Conductor {
                     ior: ConductorIor::metal(Metal::Au),
-                    alpha: 0.2,
+                    alpha: Alpha::iso(0.2),
                     multiscatter: true,
                 },
                 "Conductor(metal: Au, alpha: 0.2)",
@@ -378,7 +456,7 @@ mod tests {
                         eta: Vec3::new(0.2, 0.9, 1.1),
                         k: Vec3::new(3.9, 2.4, 2.2),
                     },
-                    alpha: 0.0,
+                    alpha: Alpha::iso(0.0),
                     multiscatter: true,
                 },
                 "Conductor(eta: Rgb(0.2, 0.9, 1.1), k: Rgb(3.9, 2.4, 2.2), alpha: 0.0)",
@@ -386,10 +464,18 @@ mod tests {
             (
                 Material::Conductor {
                     ior: ConductorIor::Reflectance(Vec3::new(0.9, 0.6, 0.3)),
-                    alpha: 0.5,
+                    alpha: Alpha::iso(0.5),
                     multiscatter: false,
                 },
                 "Conductor(reflectance: Rgb(0.9, 0.6, 0.3), alpha: 0.5, multiscatter: false)",
+            ),
+            (
+                Material::Conductor {
+                    ior: ConductorIor::metal(Metal::Ni),
+                    alpha: Alpha { x: 0.05, y: 0.4 },
+                    multiscatter: true,
+                },
+                "Conductor(metal: Ni, alpha: (0.05, 0.4))",
             ),
         ];
         for (m, want) in cases {

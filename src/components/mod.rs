@@ -10,7 +10,7 @@ pub mod texture;
 
 pub use camera::Camera;
 pub use light::PointLight;
-pub use material::{ConductorIor, Material};
+pub use material::{Alpha, ConductorIor, Material};
 pub use medium::Medium;
 pub use motion::Motion;
 pub use shape::Shape;

@@ -120,6 +120,21 @@ impl<F: Float> Frame<F> {
         let (t, b) = crate::sampling::warp::lanes::coordinate_system(n);
         Frame { t, b, n }
     }
+    /// The frame with its tangent along `t` (projected onto the tangent plane) in the lanes
+    /// `m`; a lane whose `t` is (nearly) parallel to the normal, as ∂p/∂u at a sphere's pole,
+    /// keeps its tangent.
+    #[inline(always)]
+    pub fn with_tangent(&self, m: F::Mask, t: V3<F>) -> Self {
+        let tp = t - self.n * t.dot(self.n);
+        let len2 = tp.dot(tp);
+        let m = m & len2.gt(F::splat(1e-12));
+        let tp = tp * len2.max(F::splat(1e-30)).sqrt().recip();
+        Frame {
+            t: V3::select(m, tp, self.t),
+            b: V3::select(m, self.n.cross(tp), self.b),
+            n: self.n,
+        }
+    }
     /// A world direction in the local frame.
     #[inline(always)]
     pub fn to_local(&self, v: V3<F>) -> V3<F> {

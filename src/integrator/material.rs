@@ -5,7 +5,7 @@
 use super::bsdf::{BsdfSample, Dielectric, Diffuse, Frame, Mirror, Mode};
 use super::ctx::{Ctx, DIM_BOUNCE, DIMS_PER_BOUNCE};
 use super::light::Glossy;
-use super::microfacet::{Ggx, RoughDielectric, SMOOTH_ALPHA};
+use super::microfacet::RoughDielectric;
 use super::state::{C, M, MAX_W, Paths, U, gdot, gnormalize, mask_from_bits, select_c};
 use super::surface::{
     CLASS_CONDUCTOR, CLASS_DIELECTRIC, CLASS_DIFFUSE, CLASS_MIRROR, CLASS_PLASTIC, Surface,
@@ -36,7 +36,7 @@ pub(super) fn scatter<
         .wrapping_add(st.depth.wrapping_mul(U::<F>::splat(DIMS_PER_BOUNCE)));
     st.depth = U::<F>::select(live, st.depth.wrapping_add(U::<F>::splat(1)), st.depth);
     let wo = -st.d;
-    let frame = Frame::from_normal(sf.nsf);
+    let frame = sf.frame();
     let wo_l = frame.to_local(wo);
     let class = |c: u32| live & sf.class.eq(U::<F>::splat(c));
     let (dm, mm, em) = (
@@ -57,14 +57,14 @@ pub(super) fn scatter<
     // does diffuse surfaces. Smooth ones are delta lobes, like mirrors. An interface with
     // η = 1 is none: it refracts every microfacet normal into the same direction, a delta.
     let conductor = sf.conductor();
-    let rough = sf.alpha.ge(F::splat(SMOOTH_ALPHA));
+    let rough = !sf.smooth();
     let glossy = Glossy {
         plastic: pm,
         coat: &ctx.scene.prims.coat,
         conductor: cm & rough,
         dielectric: em & rough & !eta.eq(F::one()),
         rough_dielectric: RoughDielectric {
-            dist: Ggx::isotropic(sf.alpha),
+            dist: sf.dist(),
             eta,
             schlick: ctx.schlick,
         },

@@ -2,7 +2,7 @@
 //! normal maps) and its material, sorted into material classes for the scattering stage;
 //! emitters hit by chance with their radiance and MIS weight.
 
-use super::bsdf::LaneChannels;
+use super::bsdf::{Frame, LaneChannels};
 use super::coat::Plastic;
 use super::ctx::Ctx;
 use super::microfacet::{Conductor, ConductorFresnel, Ggx, SMOOTH_ALPHA};
@@ -38,14 +38,19 @@ pub(super) struct Surface<F: Float, const N: usize> {
     /// Albedo (Diffuse) or tint (Mirror), texture-modulated; a Conductor's η (or Schlick's
     /// normal-incidence reflectance).
     pub(super) color: C<F, N>,
-    /// A Conductor's or Dielectric's GGX α, and the conductor lanes with Schlick's Fresnel
-    /// form and with multiple-scattering compensation.
-    pub(super) alpha: F,
+    /// A Conductor's, Dielectric's or Plastic's GGX α along the tangent and the bitangent,
+    /// and the conductor lanes with Schlick's Fresnel form and with multiple-scattering
+    /// compensation.
+    pub(super) ax: F,
+    pub(super) ay: F,
     pub(super) schlick: M<F>,
     pub(super) multiscatter: M<F>,
     /// A Plastic's coat IOR and the offset of its coat tables (1 and 0 elsewhere).
     pub(super) coat_ior: F,
     pub(super) coat: U<F>,
+    /// Lanes with an anisotropic roughness, and their unit tangent ∂p/∂u (elsewhere zero).
+    pub(super) aniso: M<F>,
+    pub(super) tangent: V3<F>,
     /// Each lane's material index (for a dielectric's IOR model) and primitive (for the
     /// medium behind a dielectric).
     pub(super) mat: [u32; MAX_W],
@@ -58,13 +63,41 @@ pub(super) struct Surface<F: Float, const N: usize> {
 }
 
 impl<F: Float, const N: usize> Surface<F, N> {
+    /// The lanes whose microfacet lobe is a delta: both α below [`SMOOTH_ALPHA`].
+    #[inline(always)]
+    pub(super) fn smooth(&self) -> M<F> {
+        self.ax.max(self.ay).lt(F::splat(SMOOTH_ALPHA))
+    }
+
+    /// The GGX distribution of the rough lanes. An axis below [`SMOOTH_ALPHA`] of an
+    /// anisotropic lane is held there, where D stays finite.
+    #[inline(always)]
+    pub(super) fn dist(&self) -> Ggx<F> {
+        let floor = F::splat(SMOOTH_ALPHA);
+        Ggx {
+            ax: self.ax.max(floor),
+            ay: self.ay.max(floor),
+        }
+    }
+
+    /// The shading frame around the shading normal, its tangent along ∂p/∂u in the
+    /// anisotropic lanes (an isotropic lobe is the same about any tangent).
+    #[inline(always)]
+    pub(super) fn frame(&self) -> Frame<F> {
+        let frame = Frame::from_normal(self.nsf);
+        if self.aniso.none() {
+            return frame;
+        }
+        frame.with_tangent(self.aniso, self.tangent)
+    }
+
     /// The plastic BSDF of the plastic lanes (meaningless in others), its coat tables in
     /// `tables`.
     #[inline(always)]
     pub(super) fn plastic<'a>(&self, tables: &'a [f32]) -> Plastic<'a, F, N> {
         Plastic {
-            dist: Ggx::isotropic(self.alpha),
-            smooth: self.alpha.lt(F::splat(SMOOTH_ALPHA)),
+            dist: self.dist(),
+            smooth: self.smooth(),
             eta: self.coat_ior,
             albedo: self.color,
             tables,
@@ -76,8 +109,8 @@ impl<F: Float, const N: usize> Surface<F, N> {
     #[inline(always)]
     pub(super) fn conductor(&self) -> Conductor<F, N> {
         Conductor {
-            dist: Ggx::isotropic(self.alpha),
-            smooth: self.alpha.lt(F::splat(SMOOTH_ALPHA)),
+            dist: self.dist(),
+            smooth: self.smooth(),
             multiscatter: self.multiscatter,
             fresnel: ConductorFresnel {
                 eta: self.color,
@@ -110,12 +143,17 @@ pub(crate) fn surface_material<const MOTION: bool>(
 ) -> (crate::geometry::SurfacePoint, Material, Albedo) {
     let prims = &ctx.scene.prims;
     let mut sp = prims.surface_at::<MOTION>(ray, hit, time);
-    let material = prims.materials[prims.material[hit.prim as usize] as usize];
+    let mut material = prims.materials[prims.material[hit.prim as usize] as usize];
     let mut albedo = Albedo::None;
     if (ctx.textures || ctx.normal_maps)
         && let Some(tex) = prims.texture_of(hit.prim)
     {
         let (uv, dpdu, dpdv) = prims.uv_frame::<MOTION>(ray, hit, &sp, time);
+        if ctx.textures
+            && let Some(r) = tex.roughness(uv)
+        {
+            material = material.roughened(r);
+        }
         if ctx.textures
             && let Some(a) = &tex.albedo
         {
@@ -152,7 +190,8 @@ struct Shading<T: Transport> {
     le: T::Colours,
     class: [u32; MAX_W],
     le_w: [f32; MAX_W],
-    alpha: [f32; MAX_W],
+    ax: [f32; MAX_W],
+    ay: [f32; MAX_W],
     coat_ior: [f32; MAX_W],
     coat: [u32; MAX_W],
     emit_bits: u32,
@@ -189,14 +228,14 @@ impl<T: Transport> Shading<T> {
             }
             Material::Plastic { albedo, ior, alpha } => {
                 self.class[i] = CLASS_PLASTIC;
-                self.alpha[i] = alpha;
+                (self.ax[i], self.ay[i]) = (alpha.x, alpha.y);
                 self.coat_ior[i] = ior;
                 self.coat[i] = ctx.scene.prims.coat_offset[h.mat as usize];
                 T::set_reflectance(&mut self.color, i, ctx, h.mat, albedo, textured);
             }
             Material::Dielectric { alpha, .. } => {
                 self.class[i] = CLASS_DIELECTRIC;
-                self.alpha[i] = alpha;
+                (self.ax[i], self.ay[i]) = (alpha.x, alpha.y);
             }
             Material::Conductor {
                 ior,
@@ -204,7 +243,7 @@ impl<T: Transport> Shading<T> {
                 multiscatter,
             } => {
                 self.class[i] = CLASS_CONDUCTOR;
-                self.alpha[i] = alpha;
+                (self.ax[i], self.ay[i]) = (alpha.x, alpha.y);
                 self.conductor_bits |= 1 << i;
                 self.multiscatter_bits |= u32::from(multiscatter) << i;
                 let schlick = T::set_conductor(
@@ -265,12 +304,14 @@ pub(super) fn surfaces<
     let scene = ctx.scene;
     let prims = &scene.prims;
     let (mut p, mut n, mut ns) = (Scratch3::new(), Scratch3::new(), Scratch3::new());
+    let (mut tangent, mut aniso_bits) = (Scratch3::new(), 0u32);
     let mut shade = Shading::<T> {
         color: T::colours(),
         le: T::colours(),
         class: [CLASS_NONE; MAX_W],
         le_w: [0.0; MAX_W],
-        alpha: [0.0; MAX_W],
+        ax: [0.0; MAX_W],
+        ay: [0.0; MAX_W],
         coat_ior: [1.0; MAX_W],
         coat: [0; MAX_W],
         emit_bits: 0,
@@ -304,6 +345,12 @@ pub(super) fn surfaces<
         n.set(i, sp.facing());
         ns.set(i, sp.shading_facing());
         front_bits |= (sp.front as u32) << i;
+        if material.alpha().is_some_and(|a| a.is_anisotropic()) {
+            // The loader refuses anisotropy on meshes without UVs, so ∂p/∂u exists.
+            let (_, dpdu, _) = prims.uv_frame::<MOTION>(&ray, &hit, &sp, time);
+            tangent.set(i, dpdu.normalize_or_zero());
+            aniso_bits |= 1 << i;
+        }
         let h = LaneHit {
             mat,
             prim: hit.prim,
@@ -353,7 +400,10 @@ pub(super) fn surfaces<
                 },
                 p: Vec3::new(p.x[i], p.y[i], p.z[i]),
             };
-            let m = prims.materials[mats[i] as usize].modulated(ai);
+            let mut m = prims.materials[mats[i] as usize].modulated(ai);
+            if let Some(r) = prims.textures[t as usize].roughness(Vec2::new(tu[i], tv[i])) {
+                m = m.roughened(r);
+            }
             shade.finish::<F, N, MOTION, MEDIA>(ctx, st, i, h, m, Some(ai));
         }
     }
@@ -365,11 +415,14 @@ pub(super) fn surfaces<
         front: mask_from_bits::<F>(front_bits),
         class: U::<F>::from_fn(|i| shade.class[i]),
         color: T::eval(&shade.color, &st.lam),
-        alpha: F::load(&shade.alpha),
+        ax: F::load(&shade.ax),
+        ay: F::load(&shade.ay),
         schlick: mask_from_bits::<F>(shade.schlick_bits),
         multiscatter: mask_from_bits::<F>(shade.multiscatter_bits),
         coat_ior: F::load(&shade.coat_ior),
         coat: U::<F>::from_fn(|i| shade.coat[i]),
+        aniso: mask_from_bits::<F>(aniso_bits),
+        tangent: tangent.v3(),
         mat: mats,
         prim,
         emits: mask_from_bits::<F>(shade.emit_bits),

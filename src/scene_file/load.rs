@@ -683,6 +683,26 @@ fn build_world(
                 "a medium fills a pure boundary (no material) or a Dielectric; an opaque surface would hide it".into(),
             ));
         }
+        if let Some(t) = &e.texture
+            && t.roughness.is_some()
+            && material.alpha().is_none()
+        {
+            return Err(err(
+                "texture.roughness",
+                "a roughness texture needs a Conductor, Dielectric or Plastic".into(),
+            ));
+        }
+        if let Shape::Mesh(m) = &shape
+            && m.uvs().is_none()
+            && material.alpha().is_some_and(|a| a.is_anisotropic())
+        {
+            return Err(err(
+                "material.alpha",
+                "this mesh has no UVs (vt lines or PLY u/v): an anisotropic roughness needs \
+                 them for its tangent direction"
+                    .into(),
+            ));
+        }
         if let (Some(_), Shape::Mesh(m)) = (&e.texture, &shape)
             && m.uvs().is_none()
         {
@@ -741,8 +761,8 @@ fn conductor(
     eta: Option<schema::Color>,
     k: Option<schema::Color>,
     reflectance: Option<schema::Albedo>,
-    alpha: Option<f32>,
-    roughness: Option<f32>,
+    alpha: Option<schema::Rough>,
+    roughness: Option<schema::Rough>,
 ) -> Result<Material, (&'static str, String)> {
     use crate::components::ConductorIor;
     let complex = |c: schema::Color, field: &'static str, lo_open: bool| {
@@ -801,14 +821,24 @@ fn conductor(
     })
 }
 
-/// A rough material's GGX α from its `alpha` or `roughness` field (α = roughness²), each in
-/// [0, 1], at most one of them; neither is smooth (α = 0).
-fn rough_alpha(alpha: Option<f32>, roughness: Option<f32>) -> Result<f32, (&'static str, String)> {
-    let unit = |v: f32, field: &'static str| {
-        if (0.0..=1.0).contains(&v) {
-            Ok(v)
+/// A rough material's GGX α from its `alpha` or `roughness` field (α = roughness²; a pair
+/// is anisotropic), each value in [0, 1], at most one of them; neither is smooth (α = 0).
+fn rough_alpha(
+    alpha: Option<schema::Rough>,
+    roughness: Option<schema::Rough>,
+) -> Result<crate::components::Alpha, (&'static str, String)> {
+    use crate::components::Alpha;
+    let unit = |r: schema::Rough, field: &'static str| {
+        let schema::Rough(x, y) = r;
+        if (0.0..=1.0).contains(&x) && (0.0..=1.0).contains(&y) {
+            Ok(Alpha { x, y })
+        } else if x == y {
+            Err((field, format!("must be in [0, 1], got {x}")))
         } else {
-            Err((field, format!("must be in [0, 1], got {v}")))
+            Err((
+                field,
+                format!("each of the pair must be in [0, 1], got ({x}, {y})"),
+            ))
         }
     };
     match (alpha, roughness) {
@@ -817,7 +847,10 @@ fn rough_alpha(alpha: Option<f32>, roughness: Option<f32>) -> Result<f32, (&'sta
             "give `alpha` or `roughness` (α = roughness²), not both".into(),
         )),
         (Some(a), None) => unit(a, "material.alpha"),
-        (None, Some(r)) => unit(r, "material.roughness").map(|r| r * r),
-        (None, None) => Ok(0.0),
+        (None, Some(r)) => unit(r, "material.roughness").map(|r| Alpha {
+            x: r.x * r.x,
+            y: r.y * r.y,
+        }),
+        (None, None) => Ok(Alpha::ZERO),
     }
 }

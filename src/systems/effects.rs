@@ -142,8 +142,15 @@ pub fn detect_effects(
         }
     };
     let albedo = named(&|t| t.albedo.is_some());
-    if albedo.is_empty() {
+    let roughness = named(&|t| t.roughness.is_some());
+    if albedo.is_empty() && roughness.is_empty() {
         fx.set(Effect::Textures, false, "no texture with an albedo");
+    } else if albedo.is_empty() {
+        fx.set(
+            Effect::Textures,
+            true,
+            format!("roughness texture on entity {}", list(&roughness)),
+        );
     } else {
         fx.set(
             Effect::Textures,

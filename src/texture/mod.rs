@@ -22,6 +22,51 @@ use std::sync::Arc;
 pub use image_tex::{ColorSpace, TEXTURE_EXTENSIONS, TexImage, TextureCache, TextureError, Wrap};
 pub use procedural::{Bricks, Checker, Wood};
 
+/// A colour channel of an image.
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, serde::Deserialize)]
+pub enum Channel {
+    /// Red.
+    #[default]
+    R,
+    /// Green.
+    G,
+    /// Blue.
+    B,
+}
+
+/// A scalar surface parameter (a roughness) as a function of uv, linear, clamped to [0, 1].
+#[derive(Clone, Debug, PartialEq)]
+pub enum ScalarTexture {
+    /// One channel of an image, sampled bilinearly.
+    Image {
+        /// The image's texels, read linearly.
+        image: Arc<TexImage>,
+        /// The channel read.
+        channel: Channel,
+        /// How uv outside [0, 1]² is folded back.
+        wrap: Wrap,
+    },
+    /// A checkerboard of two values (equal in the three channels).
+    Checker(Checker),
+}
+
+impl ScalarTexture {
+    /// The value at `uv`.
+    #[inline]
+    pub fn eval(&self, uv: Vec2) -> f32 {
+        let v = match self {
+            Self::Image {
+                image,
+                channel,
+                wrap,
+            } => image.bilinear(uv, *wrap)[*channel as usize],
+            Self::Checker(c) => c.eval(uv).x,
+        };
+        // An HDR image may hold any value; NaN becomes 0 too.
+        v.clamp(0.0, 1.0).max(0.0)
+    }
+}
+
 /// Reflectance as a function of uv, linear RGB.
 #[derive(Clone, Debug, PartialEq)]
 pub enum AlbedoTexture {
@@ -175,6 +220,8 @@ pub struct Texture {
     pub albedo: Option<AlbedoTexture>,
     /// Shading-normal perturbation, if any.
     pub normal_map: Option<NormalMap>,
+    /// A rough material's perceptual roughness (α = r²), if the texture sets it.
+    pub roughness: Option<ScalarTexture>,
     /// uv multiplier: `uv' = uv * scale + offset`.
     pub scale: Vec2,
     /// uv offset, added after `scale`.
@@ -248,6 +295,25 @@ impl std::fmt::Display for Texture {
                 }
             ));
         }
+        if let Some(r) = &self.roughness {
+            parts.push(format!(
+                "roughness: {}",
+                match r {
+                    ScalarTexture::Image {
+                        image,
+                        channel,
+                        wrap,
+                    } => format!(
+                        "Image({}, channel: {channel:?}, wrap: {wrap:?})",
+                        image_path(image)
+                    ),
+                    ScalarTexture::Checker(c) => format!(
+                        "Checker(a: {:?}, b: {:?}, size: {:?})",
+                        c.a.x, c.b.x, c.size
+                    ),
+                }
+            ));
+        }
         if self.scale != Vec2::ONE {
             parts.push(format!("scale: ({:?}, {:?})", self.scale.x, self.scale.y));
         }
@@ -266,6 +332,12 @@ impl Texture {
     #[inline]
     pub fn map_uv(&self, uv: Vec2) -> Vec2 {
         uv * self.scale + self.offset
+    }
+
+    /// The perceptual roughness at surface coordinates `uv`, if this texture sets one.
+    #[inline]
+    pub fn roughness(&self, uv: Vec2) -> Option<f32> {
+        self.roughness.as_ref().map(|r| r.eval(self.map_uv(uv)))
     }
 
     /// The albedo at surface coordinates `uv`, if this texture has one.
@@ -401,6 +473,7 @@ mod tests {
         let t = Texture {
             albedo: None,
             normal_map: None,
+            roughness: None,
             scale: Vec2::ONE,
             offset: Vec2::ZERO,
         };

@@ -21,12 +21,13 @@ pub enum Material {
     Dielectric {
         /// Index of refraction inside the surface; outside it is 1.
         ior: Ior,
-        /// GGX α in [0, 1] (as Mitsuba's `alpha`): frosted glass.
+        /// GGX α in [0, 1] (as Mitsuba's `alpha`): frosted glass. A pair `(αx, αy)` is
+        /// anisotropic, αx along the surface's ∂p/∂u.
         #[serde(default)]
-        alpha: Option<f32>,
-        /// Perceptual roughness r in [0, 1] (glTF, Blender): α = r².
+        alpha: Option<Rough>,
+        /// Perceptual roughness r in [0, 1] (glTF, Blender): α = r²; a pair is anisotropic.
         #[serde(default)]
-        roughness: Option<f32>,
+        roughness: Option<Rough>,
     },
     /// A metal: GGX microfacet reflection (smooth below α = 0.001) with a conductor's Fresnel
     /// term. Exactly one of `metal`, `eta` with `k`, or `reflectance`; at most one of `alpha`
@@ -44,12 +45,13 @@ pub enum Material {
         /// An artist's normal-incidence reflectance (Schlick's form), every channel in [0, 1].
         #[serde(default)]
         reflectance: Option<Albedo>,
-        /// GGX α in [0, 1] (as Mitsuba's `alpha`).
+        /// GGX α in [0, 1] (as Mitsuba's `alpha`). A pair `(αx, αy)` is anisotropic, αx
+        /// along the surface's ∂p/∂u (brushed metal).
         #[serde(default)]
-        alpha: Option<f32>,
-        /// Perceptual roughness r in [0, 1] (glTF, Blender): α = r².
+        alpha: Option<Rough>,
+        /// Perceptual roughness r in [0, 1] (glTF, Blender): α = r²; a pair is anisotropic.
         #[serde(default)]
-        roughness: Option<f32>,
+        roughness: Option<Rough>,
         /// Restore the energy single scattering among the microfacets loses (Kulla & Conty
         /// 2017); default `true`. `false` matches renderers without it (Mitsuba's
         /// `roughconductor`, pbrt-v4's `conductor`).
@@ -65,12 +67,12 @@ pub enum Material {
         /// The coat's refractive index in [1, 3]; default 1.5.
         #[serde(default)]
         ior: Option<f32>,
-        /// The coat's GGX α in [0, 1].
+        /// The coat's GGX α in [0, 1]; a pair `(αx, αy)` is anisotropic.
         #[serde(default)]
-        alpha: Option<f32>,
-        /// The coat's perceptual roughness r in [0, 1]: α = r².
+        alpha: Option<Rough>,
+        /// The coat's perceptual roughness r in [0, 1]: α = r²; a pair is anisotropic.
         #[serde(default)]
-        roughness: Option<f32>,
+        roughness: Option<Rough>,
     },
     /// An area light on a Sphere, Rect or Disk; it emits and does not scatter.
     Light {
@@ -305,5 +307,91 @@ impl TryFrom<EmissionSpec> for Emission {
             rgb: spectrum.rgb().unwrap_or_default(),
             spectrum,
         })
+    }
+}
+
+/// A roughness as a scene writes it: one number (isotropic) or a pair `(x, y)`, x along the
+/// surface's tangent ∂p/∂u. The loader checks the range.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Rough(pub f32, pub f32);
+
+impl<'de> Deserialize<'de> for Rough {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> Result<Self, D::Error> {
+        struct V;
+        impl<'de> serde::de::Visitor<'de> for V {
+            type Value = Rough;
+            fn expecting(&self, f: &mut std::fmt::Formatter) -> std::fmt::Result {
+                f.write_str("a number, or a pair (along u, along v) for an anisotropic surface")
+            }
+            fn visit_f64<E: serde::de::Error>(self, v: f64) -> Result<Rough, E> {
+                Ok(Rough(v as f32, v as f32))
+            }
+            fn visit_i64<E: serde::de::Error>(self, v: i64) -> Result<Rough, E> {
+                self.visit_f64(v as f64)
+            }
+            fn visit_u64<E: serde::de::Error>(self, v: u64) -> Result<Rough, E> {
+                self.visit_f64(v as f64)
+            }
+            fn visit_seq<A: serde::de::SeqAccess<'de>>(
+                self,
+                mut seq: A,
+            ) -> Result<Rough, A::Error> {
+                use serde::de::Error;
+                let x: f32 = seq
+                    .next_element()?
+                    .ok_or_else(|| A::Error::invalid_length(0, &self))?;
+                let y: f32 = seq
+                    .next_element()?
+                    .ok_or_else(|| A::Error::invalid_length(1, &self))?;
+                if seq.next_element::<f32>()?.is_some() {
+                    return Err(A::Error::invalid_length(3, &self));
+                }
+                Ok(Rough(x, y))
+            }
+        }
+        d.deserialize_any(V)
+    }
+}
+
+#[cfg(test)]
+mod rough_tests {
+    use super::*;
+
+    fn parse(text: &str) -> Result<Material, ron::error::SpannedError> {
+        crate::scene_file::load::ron_options().from_str::<Material>(text)
+    }
+
+    /// One number is isotropic, a pair anisotropic, with or without `Some`; a triple or a
+    /// string is refused.
+    #[test]
+    fn roughness_is_a_number_or_a_pair() {
+        for (text, want) in [
+            ("Conductor(metal: Au, alpha: 0.2)", Rough(0.2, 0.2)),
+            ("Conductor(metal: Au, alpha: 1)", Rough(1.0, 1.0)),
+            ("Conductor(metal: Au, alpha: Some(0.3))", Rough(0.3, 0.3)),
+            ("Conductor(metal: Au, alpha: (0.05, 0.4))", Rough(0.05, 0.4)),
+            (
+                "Conductor(metal: Au, alpha: Some((0.05, 0.4)))",
+                Rough(0.05, 0.4),
+            ),
+        ] {
+            let Ok(Material::Conductor { alpha, .. }) = parse(text) else {
+                panic!("{text}");
+            };
+            assert_eq!(alpha, Some(want), "{text}");
+        }
+        for text in [
+            "Conductor(metal: Au, alpha: (0.1, 0.2, 0.3))",
+            "Conductor(metal: Au, alpha: (0.1))",
+            "Conductor(metal: Au, alpha: \"rough\")",
+        ] {
+            assert!(parse(text).is_err(), "{text}");
+        }
+        let Ok(Material::Plastic { roughness, .. }) =
+            parse("Plastic(albedo: Rgb(1, 1, 1), roughness: (0.2, 0.5))")
+        else {
+            panic!("plastic");
+        };
+        assert_eq!(roughness, Some(Rough(0.2, 0.5)));
     }
 }

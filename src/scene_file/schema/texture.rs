@@ -7,6 +7,7 @@
 //! texture: (
 //!     albedo: Image(path: "../assets/earth.jpg", wrap: Repeat),
 //!     normal_map: Image(path: "n.png", flip_y: false),
+//!     roughness: Checker(a: 0.2, b: 0.6, size: 0.1),
 //!     scale: (1.0, 1.0),
 //!     offset: (0.0, 0.0),
 //! )
@@ -14,13 +15,13 @@
 
 use std::path::Path;
 
-use glam::Vec2;
+use glam::{Vec2, Vec3};
 use serde::Deserialize;
 
-use super::{Albedo, NonNegative, Positive};
+use super::{Albedo, NonNegative, Positive, Unit};
 use crate::texture::image_tex::{ColorSpace, TextureCache, TextureError, Wrap};
 use crate::texture::procedural::{Bricks, Checker, Wood};
-use crate::texture::{AlbedoTexture, NormalMap, Texture};
+use crate::texture::{AlbedoTexture, NormalMap, ScalarTexture, Texture};
 
 /// The `texture:` field; every part is optional. `scale` and `offset` map surface uv before
 /// lookup: `uv' = uv * scale + offset` (defaults (1, 1) and (0, 0)).
@@ -38,6 +39,8 @@ pub struct TextureSpec {
     pub albedo: Option<AlbedoSpec>,
     /// Perturbs the shading normal.
     pub normal_map: Option<NormalMapSpec>,
+    /// The perceptual roughness r (α = r²) of a Conductor, Dielectric or Plastic.
+    pub roughness: Option<RoughnessSpec>,
     /// Multiplies surface uv before lookup; default (1, 1).
     pub scale: Option<UvScale>,
     /// Added to surface uv after `scale`; default (0, 0).
@@ -51,6 +54,8 @@ struct TextureSpecFields {
     albedo: Option<AlbedoSpec>,
     #[serde(default)]
     normal_map: Option<NormalMapSpec>,
+    #[serde(default)]
+    roughness: Option<RoughnessSpec>,
     #[serde(default)]
     scale: Option<UvScale>,
     #[serde(default)]
@@ -68,6 +73,7 @@ impl TryFrom<TextureSpecFields> for TextureSpec {
         Ok(TextureSpec {
             albedo: f.albedo,
             normal_map: f.normal_map,
+            roughness: f.roughness,
             scale: f.scale,
             offset: f.offset,
         })
@@ -176,6 +182,41 @@ pub enum NormalMapSpec {
         /// Relief scale, any finite number (negative inverts the relief); default 1.
         #[serde(default = "default_strength")]
         strength: Strength,
+    },
+}
+
+/// Where a surface's roughness comes from: a perceptual roughness r in [0, 1], α = r² (as
+/// the material's `roughness:` field, glTF and Blender).
+///
+/// ```ron
+/// Checker(a: 0.2, b: 0.6, size: 0.1)
+/// Image(path: "rough.png", channel: R)   // channel: R | G | B, default R; wrap as for albedo
+/// ```
+///
+/// Images are read linearly (never sRGB-decoded): a texel of 8-bit value v is r = v/255.
+/// On an anisotropic material the texture sets √(αx·αy) and keeps αx/αy.
+#[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub enum RoughnessSpec {
+    /// One channel of an image file, sampled bilinearly.
+    Image {
+        /// The image file, relative to the scene file's directory.
+        path: ImagePath,
+        /// The channel holding the roughness; default `R`.
+        #[serde(default)]
+        channel: crate::texture::Channel,
+        /// How uv outside [0, 1]² folds back; default `Repeat`.
+        #[serde(default)]
+        wrap: Wrap,
+    },
+    /// A checkerboard of two roughnesses.
+    Checker {
+        /// Roughness of the square touching the uv origin from above-right, in [0, 1].
+        a: Unit,
+        /// Roughness of the other squares, in [0, 1].
+        b: Unit,
+        /// Side of a square in uv units, > 0.
+        size: Positive,
     },
 }
 
@@ -301,9 +342,27 @@ impl TextureSpec {
             None => None,
             Some(n) => Some(n.build(base_dir, cache)?),
         };
+        let roughness = match &self.roughness {
+            None => None,
+            Some(RoughnessSpec::Image {
+                path,
+                channel,
+                wrap,
+            }) => Some(ScalarTexture::Image {
+                image: cache.get(&base_dir.join(&path.0), ColorSpace::Linear)?,
+                channel: *channel,
+                wrap: *wrap,
+            }),
+            Some(RoughnessSpec::Checker { a, b, size }) => Some(ScalarTexture::Checker(Checker {
+                a: Vec3::splat(a.0),
+                b: Vec3::splat(b.0),
+                size: size.0,
+            })),
+        };
         Ok(Texture {
             albedo,
             normal_map,
+            roughness,
             scale: self.scale.map_or(Vec2::ONE, |s| Vec2::from_array(s.0)),
             offset: self.offset.map_or(Vec2::ZERO, |o| Vec2::from_array(o.0)),
         })
@@ -575,8 +634,11 @@ mod tests {
 
     #[test]
     fn unknown_fields_are_refused() {
-        let (msg, _) = error::<TextureSpec>("(albedo: None, roughness: 0.5)");
-        assert!(msg.contains("roughness"), "{msg}");
+        let (msg, _) = error::<TextureSpec>("(albedo: None, glossiness: 0.5)");
+        assert!(msg.contains("glossiness"), "{msg}");
+        let (msg, _) =
+            error::<TextureSpec>("(roughness: Checker(a: 0.1, b: 0.2, size: 1.0, c: 3))");
+        assert!(msg.contains("`c`"), "{msg}");
         let (msg, _) = error::<TextureSpec>(
             "(albedo: Checker(a: Rgb(1, 1, 1), b: Rgb(0, 0, 0), size: 1.0, colour: 2))",
         );

@@ -52,6 +52,9 @@ checked_number!(
     /// A finite number > 0.
     Positive(f32, "f32"), |x: f32| x.is_finite() && x > 0.0, "a finite number > 0");
 checked_number!(
+    /// A number in [0, 1].
+    Unit(f32, "f32"), |x: f32| (0.0..=1.0).contains(&x), "in [0, 1]");
+checked_number!(
     /// A finite number >= 0.
     NonNegative(f32, "f32"), |x: f32| x.is_finite() && x >= 0.0, "a finite number >= 0");
 checked_number!(
