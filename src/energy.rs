@@ -169,3 +169,180 @@ pub fn coat_table_cached(eta: f32) -> Arc<[f32]> {
         .or_insert(t)
         .clone()
 }
+
+/// The single-scattering albedo of a rough dielectric interface (GGX α, relative IOR `eta`
+/// transmitted over incident) lit at incidence cosine `mu`: the reflected and the
+/// transmitted shares of the flux, by the quadrature of [`ggx_albedo_with`]. Per microfacet
+/// normal h visible from wo, the flux D(h)·(wo·h)/μ dωh leaves reflected with F(wo·h) and
+/// refracted with 1 − F, each masked by G2; both terms share the normal's measure, since
+/// f_t·|μi| dωi = (1 − F)·D·G2·(wo·h)/μ dωh (Walter et al. 2007).
+pub fn dielectric_albedo(mu: f64, alpha: f64, eta: f64, (nt, np): (usize, usize)) -> (f64, f64) {
+    use std::f64::consts::PI;
+    if alpha <= 0.0 {
+        let f = fresnel_f64(mu, eta);
+        return (f, 1.0 - f);
+    }
+    let mu = mu.clamp(1e-4, 1.0);
+    let wo = [(1.0 - mu * mu).sqrt(), 0.0, mu];
+    let a2 = alpha * alpha;
+    let s = |w: [f64; 3]| (a2 * (w[0] * w[0] + w[1] * w[1]) + w[2] * w[2]).sqrt();
+    let g2 = |wi: [f64; 3]| {
+        let zi = wi[2].abs();
+        2.0 * wo[2] * zi / (s(wo) * zi + s(wi) * wo[2])
+    };
+    let (mut r, mut t) = (0.0, 0.0);
+    for i in 0..nt {
+        let tt = (i as f64 + 0.5) / nt as f64;
+        let cos = 1.0 - tt * tt;
+        let sin = (1.0 - cos * cos).max(0.0).sqrt();
+        let dcos = 2.0 * tt / nt as f64;
+        for j in 0..np {
+            let phi = (j as f64 + 0.5) / np as f64 * PI;
+            let h = [sin * phi.cos(), sin * phi.sin(), cos];
+            let oh = wo[0] * h[0] + wo[2] * h[2];
+            if oh <= 0.0 {
+                continue;
+            }
+            let q = (h[0] * h[0] + h[1] * h[1]) / a2 + h[2] * h[2];
+            let d = 1.0 / (PI * a2 * q * q);
+            let measure = d * oh / mu * dcos * (2.0 * PI / np as f64);
+            let f = fresnel_f64(oh, eta);
+            let wr = [
+                2.0 * oh * h[0] - wo[0],
+                2.0 * oh * h[1],
+                2.0 * oh * h[2] - wo[2],
+            ];
+            if wr[2] > 0.0 {
+                r += f * g2(wr) * measure;
+            }
+            let cos2_t = 1.0 - (1.0 - oh * oh) / (eta * eta);
+            if f < 1.0 && cos2_t > 0.0 {
+                let k = oh / eta - cos2_t.sqrt();
+                let wt = [-wo[0] / eta + k * h[0], k * h[1], -wo[2] / eta + k * h[2]];
+                if wt[2] < 0.0 {
+                    t += (1.0 - f) * g2(wt) * measure;
+                }
+            }
+        }
+    }
+    (r, t)
+}
+
+/// The relative IORs of the rough dielectric's energy tables: η = 1 + k/10, k < 21, from
+/// the side light enters (η ≥ 1) and, as 1/η, from the side it leaves.
+pub const DIELECTRIC_ETAS: usize = 21;
+/// Where the tables of [`dielectric_energy_table`] start: E(μ, α) per side and η on a
+/// `TABLE_SIZE`² grid (row per α), then E_avg(α) per side and η, then the share of the
+/// compensation lobe that is transmitted, per side and η.
+pub const DIELECTRIC_AVG: usize = 2 * DIELECTRIC_ETAS * TABLE_SIZE * TABLE_SIZE;
+/// See [`DIELECTRIC_AVG`].
+pub const DIELECTRIC_SPLIT: usize = DIELECTRIC_AVG + 2 * DIELECTRIC_ETAS * TABLE_SIZE;
+/// The length of [`dielectric_energy_table`].
+pub const DIELECTRIC_TABLE_LEN: usize = DIELECTRIC_SPLIT + 2 * DIELECTRIC_ETAS * TABLE_SIZE;
+/// The quadrature grid of the committed dielectric tables.
+pub const DIELECTRIC_GRID: (usize, usize) = (512, 128);
+
+/// The relative IOR of slice `k` seen from `side` (0: entering, 1: leaving).
+pub fn dielectric_table_eta(side: usize, k: usize) -> f64 {
+    let eta = 1.0 + k as f64 / 10.0;
+    if side == 0 { eta } else { 1.0 / eta }
+}
+
+/// 2∫E(μ)μ dμ of `e` on the `TABLE_SIZE` grid of μ, linear on each cell, integrated
+/// exactly: the average a lookup's interpolant has.
+fn linear_average(e: &[f64]) -> f64 {
+    let last = (e.len() - 1) as f64;
+    let h = 1.0 / last;
+    let s: f64 = (0..e.len() - 1)
+        .map(|i| {
+            let (m0, m1) = (i as f64 * h, (i + 1) as f64 * h);
+            let s = (e[i + 1] - e[i]) / h;
+            let c = e[i] - s * m0;
+            c * (m1 * m1 - m0 * m0) / 2.0 + s * (m1.powi(3) - m0.powi(3)) / 3.0
+        })
+        .sum();
+    2.0 * s
+}
+
+/// A value of [0, 1] as the committed tables store it, 16 bits fixed point.
+pub fn quantize_unit(v: f64) -> u16 {
+    (v.clamp(0.0, 1.0) * 65535.0).round() as u16
+}
+
+/// The value a stored 16-bit entry stands for.
+pub fn dequantize_unit(q: u16) -> f64 {
+    f64::from(q) / 65535.0
+}
+
+/// The energy tables of the rough dielectric's multiple-scattering compensation, quantized
+/// (layout at [`DIELECTRIC_AVG`]), by `grid` quadrature per entry.
+///
+/// Kulla & Conty 2017 restore the energy 1 − E(μo) single scattering loses with a lobe
+/// (1 − E(μo))(1 − E'(μi)) / (π(1 − E'_avg)) on each side, E' the table of the side wi is
+/// on, reflected with share 1 − x and transmitted with share x. Reciprocity across the
+/// interface (f(o, i)/η_i² = f(i, o)/η_o²) ties the two sides' transmitted shares:
+/// x₋ = x₊ (1 − E₊avg) / ((1 − E₋avg) η²), with x₊ the transmitted share of single
+/// scattering from outside, lowered where x₋ would exceed 1.
+pub fn dielectric_energy_table(grid: (usize, usize)) -> Vec<u16> {
+    use rayon::prelude::*;
+    let n = TABLE_SIZE;
+    let last = (n - 1) as f64;
+    let slices: Vec<(usize, usize)> = (0..2)
+        .flat_map(|s| (0..DIELECTRIC_ETAS).map(move |k| (s, k)))
+        .collect();
+    // Per slice: E rows (quantized), E_avg per α (of the dequantized rows), T_avg per α.
+    let built: Vec<(Vec<u16>, Vec<f64>, Vec<f64>)> = slices
+        .par_iter()
+        .map(|&(side, k)| {
+            let eta = dielectric_table_eta(side, k);
+            let mut e = Vec::with_capacity(n * n);
+            let (mut avg, mut t_avg) = (Vec::new(), Vec::new());
+            for j in 0..n {
+                let alpha = j as f64 / last;
+                let rows: Vec<(f64, f64)> = (0..n)
+                    .map(|i| dielectric_albedo(i as f64 / last, alpha, eta, grid))
+                    .collect();
+                let q: Vec<u16> = rows.iter().map(|&(r, t)| quantize_unit(r + t)).collect();
+                let deq: Vec<f64> = q.iter().map(|&v| dequantize_unit(v)).collect();
+                let tr: Vec<f64> = rows.iter().map(|&(_, t)| t).collect();
+                avg.push(linear_average(&deq));
+                t_avg.push(linear_average(&tr));
+                e.extend(q);
+            }
+            (e, avg, t_avg)
+        })
+        .collect();
+    let mut out = Vec::with_capacity(DIELECTRIC_TABLE_LEN);
+    for (e, _, _) in &built {
+        out.extend_from_slice(e);
+    }
+    let avg_q: Vec<Vec<u16>> = built
+        .iter()
+        .map(|(_, a, _)| a.iter().map(|&v| quantize_unit(v)).collect())
+        .collect();
+    for a in &avg_q {
+        out.extend_from_slice(a);
+    }
+    let mut split = vec![0u16; 2 * DIELECTRIC_ETAS * n];
+    for k in 0..DIELECTRIC_ETAS {
+        let eta = dielectric_table_eta(0, k);
+        let (enter, leave) = (k, DIELECTRIC_ETAS + k);
+        for j in 0..n {
+            let ea = dequantize_unit(avg_q[enter][j]);
+            let eb = dequantize_unit(avg_q[leave][j]);
+            let (t_in, e_in) = (built[enter].2[j], built[enter].1[j]);
+            let mut x_in = if e_in > 0.0 { t_in / e_in } else { 1.0 };
+            let (la, lb) = (1.0 - ea, (1.0 - eb) * eta * eta);
+            let mut x_out = if lb > 1e-9 { x_in * la / lb } else { 0.0 };
+            if x_out > 1.0 {
+                x_out = 1.0;
+                x_in = if la > 1e-9 { lb / la } else { x_in };
+            }
+            split[enter * n + j] = quantize_unit(x_in);
+            split[leave * n + j] = quantize_unit(x_out);
+        }
+    }
+    out.extend(split);
+    debug_assert_eq!(out.len(), DIELECTRIC_TABLE_LEN);
+    out
+}

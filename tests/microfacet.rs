@@ -339,11 +339,18 @@ impl LaneKernel for Conductors<'_> {
                 vals.extend(cd.eval(wo, wi).0);
             }
             let uc = F::from_fn(|l| (at(l).2[0] + at(l).2[1]).fract());
-            for (eta, schlick) in [(1.5, false), (1.0 / 1.5, false), (1.33, true)] {
+            for (eta, schlick, ms) in [
+                (1.5, false, false),
+                (1.0 / 1.5, false, false),
+                (1.33, true, false),
+                (1.5, false, true),
+                (1.0 / 2.2, false, true),
+            ] {
                 let d = RoughDielectric {
                     dist: Ggx { ax, ay },
                     eta: F::splat(eta),
                     schlick,
+                    multiscatter: F::Mask::splat(ms),
                 };
                 let s = d.sample::<Chan<F, 1>>(wo, uc, u1, u2, Mode::Radiance);
                 vals.extend([s.wi.x, s.wi.y, s.wi.z, s.pdf, s.weight.0[0], d.pdf(wo, wi)]);
@@ -363,10 +370,15 @@ impl LaneKernel for Conductors<'_> {
 }
 
 fn glass(alpha: f32, eta: f32) -> RoughDielectric<f32> {
+    compensated_glass(alpha, eta, false)
+}
+
+fn compensated_glass(alpha: f32, eta: f32, multiscatter: bool) -> RoughDielectric<f32> {
     RoughDielectric {
         dist: Ggx::isotropic(alpha),
         eta,
         schlick: false,
+        multiscatter,
     }
 }
 
@@ -527,6 +539,149 @@ fn rough_dielectric_conserves_energy() {
                 }
             }
         }
+    }
+}
+
+/// With compensation the sampler mixes single scattering with a cosine lobe on each side;
+/// the mixture follows `pdf` over the whole sphere (χ², entering and leaving glass, normal
+/// and grazing incidence) and each sample's weight is f·|cos|/pdf of the compensated f.
+#[test]
+fn compensated_rough_dielectric_sampling_follows_its_pdf_and_weight() {
+    let cases = [
+        (0.3f32, 0.0f32, 1.5f32),
+        (1.0, 85.0, 1.5),
+        (0.3, 30.0, 1.0 / 1.5),
+        (1.0, 70.0, 1.0 / 1.5),
+        (0.6, 45.0, 2.4),
+    ];
+    for (k, &(alpha, theta, eta)) in cases.iter().enumerate() {
+        let b = compensated_glass(alpha, eta, true);
+        let wo = incident(theta);
+        let mut g = SplitMix(70 + k as u64);
+        let sample = |u: glam::Vec2| {
+            let uc = g.range(0.0, 1.0) as f32;
+            let s = b.sample::<Chan<f32, 1>>(wo, uc, u.x, u.y, Mode::Radiance);
+            (s.pdf > 0.0).then(|| Vec3::from(s.wi))
+        };
+        let pdf = |w: Vec3| b.pdf(wo, w.into());
+        if let Err(err) = Chi2::new(400_000, 80 + k as u64)
+            .tests(cases.len())
+            .max_depth(7)
+            .directions([0.0, 2.0], sample, pdf)
+        {
+            panic!("α = {alpha}, θ = {theta}°, η = {eta}: {err}");
+        }
+        let mut g = SplitMix(90 + k as u64);
+        for _ in 0..5000 {
+            let u = [0; 3].map(|_| g.range(0.0, 1.0) as f32);
+            for mode in [Mode::Radiance, Mode::Importance] {
+                let s = b.sample::<Chan<f32, 1>>(wo, u[0], u[1], u[2], mode);
+                if s.pdf == 0.0 {
+                    assert_eq!(s.weight.0[0], 0.0);
+                    continue;
+                }
+                let t = s.wi.z < 0.0;
+                assert_eq!(s.is_transmission(), t);
+                let pdf = b.pdf(wo, s.wi);
+                assert!((s.pdf - pdf).abs() <= 1e-3 * pdf, "{} vs {pdf}", s.pdf);
+                let w = b.eval(wo, s.wi, mode) * s.wi.z.abs() / pdf;
+                assert!((w - s.weight.0[0]).abs() <= 1e-3 * w.max(1e-3));
+            }
+        }
+    }
+}
+
+/// The compensation lobe keeps refraction adjoint: importance from wo to wi equals radiance
+/// from wi to wo through the interface seen from the other side, which holds only because
+/// the two sides' transmitted shares are tied by x₋(1 − E₋avg)η² = x₊(1 − E₊avg).
+#[test]
+fn compensated_rough_dielectric_is_reciprocal_and_adjoint() {
+    let mut g = SplitMix(24);
+    let up = |g: &mut SplitMix| {
+        let z = g.range(0.02, 1.0) as f32;
+        let phi = g.range(0.0, std::f64::consts::TAU) as f32;
+        let r = (1.0 - z * z).sqrt();
+        V3::<f32>::new(r * phi.cos(), r * phi.sin(), z)
+    };
+    let flip = |w: V3<f32>| V3::new(w.x, w.y, -w.z);
+    for &(alpha, eta) in &[(0.35f32, 1.5f32), (0.9, 1.0 / 1.33), (0.6, 2.2)] {
+        let b = compensated_glass(alpha, eta, true);
+        let back = compensated_glass(alpha, 1.0 / eta, true);
+        for _ in 0..20_000 {
+            let (a, c) = (up(&mut g), up(&mut g));
+            let (fac, fca) = (b.eval(a, c, Mode::Radiance), b.eval(c, a, Mode::Radiance));
+            assert!((fac - fca).abs() <= 1e-4 * fac.max(1.0), "{fac} vs {fca}");
+            let wi = flip(c);
+            let imp = b.eval(a, wi, Mode::Importance);
+            let rad = back.eval(c, flip(a), Mode::Radiance);
+            let h = (wi * eta + a).normalize();
+            let thin = if eta > 1.0 { a.dot(h) } else { wi.dot(h) }.abs();
+            let tol = if thin < 0.05 { 2e-2 } else { 2e-3 };
+            // The lobe alone is never zero between two directions: every pair transmits.
+            assert!(imp > 0.0, "α {alpha} η {eta}: a {a:?} c {c:?}");
+            assert!(
+                (imp - rad).abs() <= tol * imp.max(1e-2),
+                "α {alpha} η {eta}: {imp} vs {rad}, a {a:?} c {c:?}"
+            );
+        }
+    }
+}
+
+/// With compensation the interface neither absorbs nor creates light: ∫ f |cos| dω over the
+/// sphere (the mean sampled weight in importance form) is 1 within the tables' accuracy and
+/// the estimate's noise (200 000 samples) at every roughness, incidence and side.
+#[test]
+fn compensated_rough_dielectric_keeps_all_the_energy() {
+    let mut g = SplitMix(25);
+    for &alpha in &[0.1f32, 0.3, 0.6, 1.0] {
+        for &eta in &[1.5f32, 1.0 / 1.5, 1.33, 2.4] {
+            let b = compensated_glass(alpha, eta, true);
+            for theta in [0.0f32, 40.0, 75.0, 88.0] {
+                let wo = incident(theta);
+                let n = 200_000;
+                let (mut sum, mut sq) = (0.0f64, 0.0f64);
+                for _ in 0..n {
+                    let u = [0; 3].map(|_| g.range(0.0, 1.0) as f32);
+                    let s = b.sample::<Chan<f32, 1>>(wo, u[0], u[1], u[2], Mode::Importance);
+                    let w = f64::from(s.weight.0[0]);
+                    sum += w;
+                    sq += w * w;
+                }
+                let e = sum / f64::from(n);
+                let sd = ((sq / f64::from(n) - e * e).max(0.0) / f64::from(n)).sqrt();
+                assert!(
+                    (e - 1.0).abs() <= 4.0 * sd + 5e-3,
+                    "α {alpha}, η {eta}, θ {theta}: {e} ± {sd}"
+                );
+            }
+        }
+    }
+}
+
+/// The committed dielectric tables are what the quadrature gives (a few entries recomputed
+/// at grid points, where the lookup returns the stored value).
+#[test]
+fn dielectric_energy_tables_match_the_quadrature() {
+    use prism::energy::{DIELECTRIC_GRID, dielectric_albedo};
+    use prism::integrator::dielectric_energy::Slices;
+    for (i, j, k, leaving) in [
+        (0, 5, 5, false),
+        (3, 3, 5, true),
+        (10, 20, 0, false),
+        (31, 31, 20, true),
+        (16, 9, 3, false),
+        (25, 28, 14, true),
+    ] {
+        let (mu, alpha) = (i as f32 / 31.0, j as f32 / 31.0);
+        let eta = 1.0 + k as f64 / 10.0;
+        let eta = if leaving { 1.0 / eta } else { eta };
+        let (r, t) = dielectric_albedo(f64::from(mu), f64::from(alpha), eta, DIELECTRIC_GRID);
+        let want = (r + t).min(1.0);
+        let got = f64::from(Slices::<f32>::new(eta as f32).albedo(false, mu, alpha));
+        assert!(
+            (got - want).abs() < 3e-5,
+            "E({mu}, {alpha}, η {eta}): {got} vs {want}"
+        );
     }
 }
 

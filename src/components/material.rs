@@ -42,6 +42,8 @@ pub enum Material {
         ior: IorModel,
         /// GGX roughness α, each axis in [0, 1]; 0 is smooth.
         alpha: Alpha,
+        /// Restore the energy of light scattered among microfacets (Kulla & Conty 2017).
+        multiscatter: bool,
     },
     /// A metal: GGX microfacet reflection with a conductor's Fresnel term; a mirror weighted
     /// by that term when `alpha` is below [`crate::integrator::microfacet::SMOOTH_ALPHA`].
@@ -290,7 +292,11 @@ impl std::fmt::Display for Material {
         match self {
             Material::Diffuse { albedo } => write!(f, "Diffuse(albedo: {})", Rgb(*albedo)),
             Material::Mirror { tint } => write!(f, "Mirror(tint: {})", Rgb(*tint)),
-            Material::Dielectric { ior, alpha } => {
+            Material::Dielectric {
+                ior,
+                alpha,
+                multiscatter,
+            } => {
                 let ior = match IorPreset::ALL.into_iter().find(|p| p.model() == *ior) {
                     Some(p) => format!("Preset({})", p.name()),
                     None => match ior {
@@ -303,11 +309,14 @@ impl std::fmt::Display for Material {
                         IorModel::Sellmeier4 { b, c } => format!("Sellmeier4(b: {b:?}, c: {c:?})"),
                     },
                 };
+                write!(f, "Dielectric(ior: {ior}")?;
                 if alpha.is_rough() {
-                    write!(f, "Dielectric(ior: {ior}, alpha: {alpha})")
-                } else {
-                    write!(f, "Dielectric(ior: {ior})")
+                    write!(f, ", alpha: {alpha}")?;
+                    if !multiscatter {
+                        f.write_str(", multiscatter: false")?;
+                    }
                 }
+                f.write_str(")")
             }
             Material::Conductor {
                 ior,
@@ -384,6 +393,7 @@ mod tests {
                 Material::Dielectric {
                     ior: IorModel::Constant(1.5),
                     alpha: Alpha::iso(0.0),
+                    multiscatter: true,
                 },
                 "Dielectric(ior: Constant(1.5))",
             ),
@@ -391,6 +401,7 @@ mod tests {
                 Material::Dielectric {
                     ior: IorModel::Constant(1.5),
                     alpha: Alpha::iso(0.25),
+                    multiscatter: true,
                 },
                 "Dielectric(ior: Constant(1.5), alpha: 0.25)",
             ),
@@ -414,6 +425,7 @@ mod tests {
                 Material::Dielectric {
                     ior: IorModel::Cauchy { a: 1.5, b: 0.004 },
                     alpha: Alpha::iso(0.0),
+                    multiscatter: true,
                 },
                 "Dielectric(ior: Cauchy(a: 1.5, b: 0.004))",
             ),
@@ -421,6 +433,7 @@ mod tests {
                 Material::Dielectric {
                     ior: IorPreset::Water.model(),
                     alpha: Alpha::iso(0.0),
+                    multiscatter: true,
                 },
                 "Dielectric(ior: Preset(Water))",
             ),

@@ -67,6 +67,7 @@ pub(super) fn scatter<
             dist: sf.dist(),
             eta,
             schlick: ctx.schlick,
+            multiscatter: sf.multiscatter & em & rough,
         },
     };
     let up = offset_ray_origin_lanes(sf.p, sf.nf);

@@ -26,6 +26,7 @@ use super::bsdf::{
     BsdfSample, Chan, LaneChannels, Mode, fresnel_dielectric, fresnel_schlick, lobe, reflect_local,
     refract_lanes,
 };
+use super::dielectric_energy::Slices;
 use super::ggx_tables::{GGX_E, GGX_E_AVG, GGX_TABLE_SIZE};
 use crate::simd::{Float, Mask, UInt, V3, math};
 use std::f32::consts::TAU;
@@ -358,6 +359,11 @@ impl<F: Float, const N: usize> Conductor<F, N> {
 ///   and pdf_t = (1 − F)·G1(wo)·D·(wo·h)/zo · dωh/dωi,
 ///
 /// so every sample's weight is G2/G1(wo), over η² for refracted radiance.
+///
+/// With compensation, the energy 1 − E(μo) that single scattering loses returns through a
+/// diffuse-like lobe on each side (Kulla & Conty 2017; the tables and the reciprocal split
+/// between the sides are [`crate::energy::dielectric_energy_table`]'s), sampled with
+/// probability 1 − E(μo): the interface then neither absorbs nor creates light.
 #[derive(Clone, Copy, Debug)]
 pub struct RoughDielectric<F: Float> {
     /// The microfacet distribution.
@@ -367,6 +373,17 @@ pub struct RoughDielectric<F: Float> {
     pub eta: F,
     /// Use Schlick's Fresnel approximation instead of the exact formula.
     pub schlick: bool,
+    /// Lanes with multiple-scattering compensation.
+    pub multiscatter: F::Mask,
+}
+
+/// The compensation lobe of a rough dielectric at one (wo, wi) pair: its f (importance
+/// form) and the density of sampling it once chosen.
+struct MsLobe<F> {
+    f: F,
+    pdf: F,
+    /// 1 − E(μo): the probability of choosing it.
+    p: F,
 }
 
 impl<F: Float> RoughDielectric<F> {
@@ -401,6 +418,21 @@ impl<F: Float> RoughDielectric<F> {
         mode: Mode,
     ) -> BsdfSample<F, S> {
         let (zero, one) = (F::zero(), F::one());
+        let ms = self.multiscatter;
+        let any_ms = ms.any();
+        // The compensation lobe is chosen with probability 1 − E(μo), reusing uc rescaled.
+        let (slices, diffuse, uc, u_side) = if any_ms {
+            let sl = Slices::new(self.eta);
+            let e = sl.albedo(F::Mask::splat(false), wo.z, self.dist.alpha());
+            let p = F::select(ms, one - e, zero);
+            let d = ms & uc.lt(p);
+            let lim = F::splat(ONE_MINUS_EPS);
+            let u_side = (uc / p).min(lim);
+            let u_rest = F::select(ms, ((uc - p) / (one - p)).min(lim), uc);
+            (Some(sl), d, u_rest, u_side)
+        } else {
+            (None, F::Mask::splat(false), uc, zero)
+        };
         let h = self.dist.sample_visible_normal(wo, u1, u2);
         let cos_o = wo.dot(h);
         let r = self.fresnel(cos_o);
@@ -408,7 +440,8 @@ impl<F: Float> RoughDielectric<F> {
         let t = can_refract & uc.ge(r);
         let wi = V3::select(t, wt, h * (F::splat(2.0) * cos_o) - wo);
         let (zo, zi) = (wo.z, wi.z);
-        let ok = zo.gt(zero) & cos_o.gt(zero) & F::select(t, -zi, zi).gt(zero);
+        let single_ok = zo.gt(zero) & cos_o.gt(zero) & F::select(t, -zi, zi).gt(zero);
+        let ok = single_ok;
         let (so, si) = (self.dist.stretched_len(wo), self.dist.stretched_len(wi));
         let azi = zi.abs();
         // G2/G1(wo) with both in the stretched-length form.
@@ -419,8 +452,25 @@ impl<F: Float> RoughDielectric<F> {
         let denom = cos_i + cos_o / self.eta;
         let pdf_t =
             F::splat(2.0) * d * cos_o / (zo + so) * cos_i.abs() / (denom * denom) * (one - r);
-        let pdf = F::select(ok, F::select(t, pdf_t, pdf_r), zero);
-        let weight = F::select(ok, g * F::select(t, self.scale(mode), one), zero);
+        let mut pdf = F::select(ok, F::select(t, pdf_t, pdf_r), zero);
+        let mut weight = F::select(ok, g * F::select(t, self.scale(mode), one), zero);
+        let (mut wi, mut t) = (wi, t);
+        if let Some(sl) = slices {
+            // In the compensated lanes: in `diffuse` ones a cosine-distributed direction,
+            // transmitted with the lobe's transmitted share; the weight is the mixture's
+            // f·|zi|/pdf, so a lane's numbers do not depend on its neighbours.
+            let c = crate::sampling::warp::lanes::square_to_cosine_hemisphere(u1, u2);
+            let through = u_side.lt(sl.transmitted_share(self.dist.alpha(), self.eta));
+            let c = V3::new(c.x, c.y, F::select(through, -c.z, c.z));
+            wi = V3::select(diffuse, c, wi);
+            t = (diffuse & through) | t.and_not(diffuse);
+            let (f, mix) = self.eval_pdf(wo, wi, mode, &sl);
+            // A failed single-scattering draw stays failed: its direction was not drawn
+            // from the mixture.
+            let ok = ms & (diffuse | single_ok) & zo.gt(zero) & !wi.z.eq(zero) & mix.gt(zero);
+            weight = F::select(ms, F::select(ok, f * wi.z.abs() / mix, zero), weight);
+            pdf = F::select(ms, F::select(ok, mix, zero), pdf);
+        }
         BsdfSample {
             wi,
             weight: S::splat(weight),
@@ -431,6 +481,42 @@ impl<F: Float> RoughDielectric<F> {
                 F::U32::splat(lobe::GLOSSY_REFLECTION),
             ),
             eta: F::select(t, self.eta, one),
+        }
+    }
+
+    /// f and the mixture density at (wo, wi) with the compensation lobe, its tables read
+    /// once.
+    #[inline(always)]
+    fn eval_pdf(&self, wo: V3<F>, wi: V3<F>, mode: Mode, sl: &Slices<F>) -> (F, F) {
+        let ms = self.ms_lobe(wo, wi, sl, mode);
+        let f = self.eval_single(wo, wi, mode) + ms.f;
+        let pdf = (F::one() - ms.p) * self.pdf_single(wo, wi) + ms.p * ms.pdf;
+        (f, pdf)
+    }
+
+    /// The compensation lobe at (wo, wi), zero outside the compensated lanes: its share of
+    /// the side wi is on times (1 − E(μo))(1 − E'(|μi|)) / (π(1 − E'_avg)), over η² for
+    /// transmitted radiance.
+    #[inline(always)]
+    fn ms_lobe(&self, wo: V3<F>, wi: V3<F>, sl: &Slices<F>, mode: Mode) -> MsLobe<F> {
+        let (zero, one) = (F::zero(), F::one());
+        let a = self.dist.alpha();
+        let far = wi.z.lt(zero);
+        let eo = sl.albedo(F::Mask::splat(false), wo.z, a);
+        let ei = sl.albedo(far, wi.z.abs(), a);
+        let avg = sl.average(far, a);
+        let x = sl.transmitted_share(a, self.eta);
+        let share = F::select(far, x, one - x);
+        let ok = self.multiscatter & wo.z.gt(zero) & !wi.z.eq(zero);
+        let p = F::select(self.multiscatter & wo.z.gt(zero), one - eo, zero);
+        let cosine = wi.z.abs() * F::splat(std::f32::consts::FRAC_1_PI);
+        let lobe = share * (one - eo) * (one - ei) * F::splat(std::f32::consts::FRAC_1_PI)
+            / (one - avg).max(F::splat(1e-6));
+        let scale = F::select(far, self.scale(mode), one);
+        MsLobe {
+            f: F::select(ok, lobe * scale, zero),
+            pdf: F::select(ok, share * cosine, zero),
+            p,
         }
     }
 
@@ -458,6 +544,23 @@ impl<F: Float> RoughDielectric<F> {
     /// f(wo, wi) (no cosine): colourless, one value per lane.
     #[inline(always)]
     pub fn eval(&self, wo: V3<F>, wi: V3<F>, mode: Mode) -> F {
+        let sl = self.multiscatter.any().then(|| Slices::new(self.eta));
+        self.eval_with(wo, wi, mode, sl.as_ref())
+    }
+
+    /// [`RoughDielectric::eval`], with the compensation lobe where `sl` is given.
+    #[inline(always)]
+    fn eval_with(&self, wo: V3<F>, wi: V3<F>, mode: Mode, sl: Option<&Slices<F>>) -> F {
+        let single = self.eval_single(wo, wi, mode);
+        match sl {
+            Some(sl) => single + self.ms_lobe(wo, wi, sl, mode).f,
+            None => single,
+        }
+    }
+
+    /// The single-scattering f(wo, wi).
+    #[inline(always)]
+    fn eval_single(&self, wo: V3<F>, wi: V3<F>, mode: Mode) -> F {
         let (zero, two) = (F::zero(), F::splat(2.0));
         let (h, cos_o, cos_i, reflect, ok) = self.half(wo, wi);
         let (zo, azi) = (wo.z, wi.z.abs());
@@ -474,6 +577,27 @@ impl<F: Float> RoughDielectric<F> {
     /// The solid-angle density of [`RoughDielectric::sample`] drawing `wi`.
     #[inline(always)]
     pub fn pdf(&self, wo: V3<F>, wi: V3<F>) -> F {
+        let sl = self.multiscatter.any().then(|| Slices::new(self.eta));
+        self.pdf_with(wo, wi, sl.as_ref())
+    }
+
+    /// [`RoughDielectric::pdf`], the mixture with the compensation lobe where `sl` is given.
+    #[inline(always)]
+    fn pdf_with(&self, wo: V3<F>, wi: V3<F>, sl: Option<&Slices<F>>) -> F {
+        let single = self.pdf_single(wo, wi);
+        match sl {
+            Some(sl) => {
+                // Mode only scales f, not the density.
+                let ms = self.ms_lobe(wo, wi, sl, Mode::Importance);
+                (F::one() - ms.p) * single + ms.p * ms.pdf
+            }
+            None => single,
+        }
+    }
+
+    /// The single-scattering density of drawing `wi`.
+    #[inline(always)]
+    fn pdf_single(&self, wo: V3<F>, wi: V3<F>) -> F {
         let (zero, two) = (F::zero(), F::splat(2.0));
         let (h, cos_o, cos_i, reflect, ok) = self.half(wo, wi);
         let zo = wo.z;

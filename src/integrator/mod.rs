@@ -29,6 +29,7 @@
 pub mod bsdf;
 pub mod coat;
 pub mod ctx;
+pub mod dielectric_energy;
 mod emission;
 pub mod generate;
 mod ggx_tables;

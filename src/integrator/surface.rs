@@ -233,9 +233,14 @@ impl<T: Transport> Shading<T> {
                 self.coat[i] = ctx.scene.prims.coat_offset[h.mat as usize];
                 T::set_reflectance(&mut self.color, i, ctx, h.mat, albedo, textured);
             }
-            Material::Dielectric { alpha, .. } => {
+            Material::Dielectric {
+                alpha,
+                multiscatter,
+                ..
+            } => {
                 self.class[i] = CLASS_DIELECTRIC;
                 (self.ax[i], self.ay[i]) = (alpha.x, alpha.y);
+                self.multiscatter_bits |= u32::from(multiscatter) << i;
             }
             Material::Conductor {
                 ior,

@@ -625,9 +625,11 @@ fn build_world(
                 ior,
                 alpha,
                 roughness,
+                multiscatter,
             }) => Material::Dielectric {
                 ior: ior.0,
                 alpha: rough_alpha(*alpha, *roughness).map_err(|(field, m)| err(field, m))?,
+                multiscatter: multiscatter.unwrap_or(true),
             },
             Some(schema::Material::Conductor {
                 metal,

@@ -28,6 +28,11 @@ pub enum Material {
         /// Perceptual roughness r in [0, 1] (glTF, Blender): α = r²; a pair is anisotropic.
         #[serde(default)]
         roughness: Option<Rough>,
+        /// Restore the energy single scattering among the microfacets loses (Kulla & Conty
+        /// 2017); default `true`. `false` matches renderers without it (Mitsuba's
+        /// `roughdielectric`, pbrt-v4's `dielectric`).
+        #[serde(default)]
+        multiscatter: Option<bool>,
     },
     /// A metal: GGX microfacet reflection (smooth below α = 0.001) with a conductor's Fresnel
     /// term. Exactly one of `metal`, `eta` with `k`, or `reflectance`; at most one of `alpha`
