@@ -8,8 +8,12 @@ use prism::energy::coat_table_cached;
 use prism::integrator::bsdf::{Chan, Diffuse, Mode};
 use prism::integrator::coat::Plastic;
 use prism::integrator::microfacet::{Conductor, ConductorFresnel, Ggx, RoughDielectric};
-use prism::simd::{self, Float, LaneKernel, Lanes, Mask, UInt, V3};
+use prism::simd::{self, Float, LaneKernel, Mask, UInt, V3};
 use std::hint::black_box;
+
+#[path = "common/forms.rs"]
+mod forms;
+use forms::forms;
 
 #[derive(Clone, Copy)]
 enum Bsdf {
@@ -166,20 +170,6 @@ impl LaneKernel for Run<'_> {
             r.store(&mut self.out[i..]);
         }
     }
-}
-
-fn forms() -> Vec<(String, Lanes)> {
-    let mut v = vec![
-        ("w1".to_string(), Lanes::scalar()),
-        ("portable8".to_string(), Lanes::portable(8)),
-    ];
-    if let Some(l) = Lanes::native8() {
-        v.push(("w8".to_string(), l));
-    }
-    if let Some(l) = Lanes::native16() {
-        v.push(("w16".to_string(), l));
-    }
-    v
 }
 
 fn bsdfs(c: &mut Criterion) {

@@ -3,8 +3,12 @@
 //! each width.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
-use prism::simd::{self, Float, LaneKernel, Lanes, math};
+use prism::simd::{self, Float, LaneKernel, math};
 use std::hint::black_box;
+
+#[path = "common/forms.rs"]
+mod forms;
+use forms::forms;
 
 #[derive(Clone, Copy)]
 enum Op {
@@ -44,20 +48,6 @@ impl LaneKernel for Run<'_> {
             r.store(&mut self.out[i..]);
         }
     }
-}
-
-fn forms() -> Vec<(String, Lanes)> {
-    let mut v = vec![
-        ("w1".to_string(), Lanes::scalar()),
-        ("portable8".to_string(), Lanes::portable(8)),
-    ];
-    if let Some(l) = Lanes::native8() {
-        v.push(("w8".to_string(), l));
-    }
-    if let Some(l) = Lanes::native16() {
-        v.push(("w16".to_string(), l));
-    }
-    v
 }
 
 fn lane_math(c: &mut Criterion) {

@@ -466,19 +466,25 @@ fn rough_dielectric_weight_is_f_cos_over_pdf() {
     }
 }
 
+/// A random direction above the surface, at least 0.02 from grazing.
+fn up(g: &mut SplitMix) -> V3<f32> {
+    let z = g.range(0.02, 1.0) as f32;
+    let phi = g.range(0.0, std::f64::consts::TAU) as f32;
+    let r = (1.0 - z * z).sqrt();
+    V3::new(r * phi.cos(), r * phi.sin(), z)
+}
+
+/// `w` mirrored through the surface plane.
+fn flip(w: V3<f32>) -> V3<f32> {
+    V3::new(w.x, w.y, -w.z)
+}
+
 /// Reflection is reciprocal; refraction is adjoint: importance from wo to wi equals radiance
 /// from wi to wo through the same interface seen from the other side (η → 1/η), which is
 /// f_t(wo, wi)/η_o² = f_t(wi, wo)/η_i² of the physical BTDF.
 #[test]
 fn rough_dielectric_is_reciprocal_and_adjoint() {
     let mut g = SplitMix(22);
-    let up = |g: &mut SplitMix| {
-        let z = g.range(0.02, 1.0) as f32;
-        let phi = g.range(0.0, std::f64::consts::TAU) as f32;
-        let r = (1.0 - z * z).sqrt();
-        V3::<f32>::new(r * phi.cos(), r * phi.sin(), z)
-    };
-    let flip = |w: V3<f32>| V3::new(w.x, w.y, -w.z);
     let (mut transmitted, mut reflected) = (0, 0);
     for &eta in &[1.5f32, 1.0 / 1.33] {
         let (b, back) = (glass(0.35, eta), glass(0.35, 1.0 / eta));
@@ -597,13 +603,6 @@ fn compensated_rough_dielectric_sampling_follows_its_pdf_and_weight() {
 #[test]
 fn compensated_rough_dielectric_is_reciprocal_and_adjoint() {
     let mut g = SplitMix(24);
-    let up = |g: &mut SplitMix| {
-        let z = g.range(0.02, 1.0) as f32;
-        let phi = g.range(0.0, std::f64::consts::TAU) as f32;
-        let r = (1.0 - z * z).sqrt();
-        V3::<f32>::new(r * phi.cos(), r * phi.sin(), z)
-    };
-    let flip = |w: V3<f32>| V3::new(w.x, w.y, -w.z);
     for &(alpha, eta) in &[(0.35f32, 1.5f32), (0.9, 1.0 / 1.33), (0.6, 2.2)] {
         let b = compensated_glass(alpha, eta, true);
         let back = compensated_glass(alpha, 1.0 / eta, true);
