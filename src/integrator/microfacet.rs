@@ -408,7 +408,11 @@ impl<F: Float> RoughDielectric<F> {
 
     /// A visible normal, then reflection about it with probability F or refraction. Lanes
     /// whose direction ends on the wrong side for its lobe have weight 0 and pdf 0.
-    #[inline(always)]
+    ///
+    /// Out of line, as `eval` and `pdf`: inlined into the kernel with the compensation lobe,
+    /// the kernel's register allocation took most of a release build; the call is one per
+    /// packet of lanes.
+    #[inline(never)]
     pub fn sample<S: LaneChannels<F>>(
         &self,
         wo: V3<F>,
@@ -542,7 +546,7 @@ impl<F: Float> RoughDielectric<F> {
     }
 
     /// f(wo, wi) (no cosine): colourless, one value per lane.
-    #[inline(always)]
+    #[inline(never)]
     pub fn eval(&self, wo: V3<F>, wi: V3<F>, mode: Mode) -> F {
         let sl = self.multiscatter.any().then(|| Slices::new(self.eta));
         self.eval_with(wo, wi, mode, sl.as_ref())
@@ -575,7 +579,7 @@ impl<F: Float> RoughDielectric<F> {
     }
 
     /// The solid-angle density of [`RoughDielectric::sample`] drawing `wi`.
-    #[inline(always)]
+    #[inline(never)]
     pub fn pdf(&self, wo: V3<F>, wi: V3<F>) -> F {
         let sl = self.multiscatter.any().then(|| Slices::new(self.eta));
         self.pdf_with(wo, wi, sl.as_ref())
