@@ -55,10 +55,34 @@ pub(super) fn info(a: InfoArgs) -> Result<(), CliError> {
     for (_, name, light) in points {
         println!("  {}: light: {light}", crate::components::quoted(&name));
     }
-    if scene.environment != glam::Vec3::ZERO {
+    let chosen = |l: &crate::scene::Lights| {
+        l.environment.map_or(String::new(), |i| {
+            format!(
+                "; chosen for a light sample with probability {:.3}",
+                l.table.pmf(i as usize)
+            )
+        })
+    };
+    if let Some(map) = &rs.lights.map {
+        let (w, h) = map.size();
+        let m = map.mean();
         println!(
-            "environment: Constant({})",
-            EmissionSyntax(scene.environment, scene.environment_spectrum)
+            "environment: {map}; {w}×{h} texels, mean radiance ({:.4}, {:.4}, {:.4}); \
+             sampled by {}{}",
+            m.x,
+            m.y,
+            m.z,
+            map.sampling(),
+            chosen(&rs.lights)
+        );
+    } else if let Some(map) = &scene.environment_map {
+        let (w, h) = map.size();
+        println!("environment: {map}; {w}×{h} texels, all black: it lights nothing");
+    } else if scene.environment != glam::Vec3::ZERO {
+        println!(
+            "environment: Constant({}); sampled uniformly over the sphere{}",
+            EmissionSyntax(scene.environment, scene.environment_spectrum),
+            chosen(&rs.lights)
         );
     }
     for w in rs.warnings() {

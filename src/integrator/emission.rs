@@ -18,14 +18,20 @@ pub(super) fn escaped<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize
 ) {
     let scene = ctx.scene;
     let env = scene.environment;
-    if env == Vec3::ZERO || miss.none() {
+    if miss.none() {
         return;
     }
     let first = st.depth.eq(U::<F>::splat(0)) | st.specular | M::<F>::splat(!ctx.nee);
+    if let Some(map) = scene.lights.map.as_deref() {
+        return escaped_map(ctx, st, miss, first, map);
+    }
+    if env == Vec3::ZERO {
+        return;
+    }
     let w = F::select(
         first,
         F::one(),
-        power_heuristic(st.prev_pdf, F::splat(scene.lights.pdf_environment())),
+        power_heuristic(st.prev_pdf, F::splat(scene.lights.pdf_environment(Vec3::Y))),
     );
     let e = if T::SPECTRAL {
         let mut e = T::colours();
@@ -40,6 +46,43 @@ pub(super) fn escaped<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize
         // RGB: N = 3.
         let e = [env.x, env.y, env.z];
         Chan(std::array::from_fn(|k| F::splat(e[k])))
+    };
+    st.l = select_c(miss, st.l + st.beta * e * w, st.l);
+}
+
+/// [`escaped`] for an environment map: each lane looks up the map along its direction (a
+/// bilinear lookup and the density of the map's sampling there, for MIS).
+#[inline(always)]
+fn escaped_map<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize>(
+    ctx: &Ctx,
+    st: &mut Paths<F, T, N>,
+    miss: M<F>,
+    first: M<F>,
+    map: &crate::scene::envmap::EnvMap,
+) {
+    const MAX_W: usize = 16;
+    let lights = &ctx.scene.lights;
+    let mut pdf = [0.0f32; MAX_W];
+    let mut rgb = [[0.0f32; MAX_W]; 3];
+    let mut e = T::colours();
+    let bits = miss.bits();
+    for i in 0..F::WIDTH {
+        if bits >> i & 1 != 0 {
+            let d = st.d.lane(i).normalize_or_zero();
+            let l = map.eval(d);
+            (rgb[0][i], rgb[1][i], rgb[2][i]) = (l.x, l.y, l.z);
+            pdf[i] = lights.pdf_environment(d);
+            if T::SPECTRAL {
+                T::set_map_radiance(&mut e, i, l, &st.lam);
+            }
+        }
+    }
+    let w = F::select(first, F::one(), power_heuristic(st.prev_pdf, F::load(&pdf)));
+    let e = if T::SPECTRAL {
+        T::eval(&e, &st.lam)
+    } else {
+        // RGB: N = 3.
+        Chan(std::array::from_fn(|k| F::load(&rgb[k])))
     };
     st.l = select_c(miss, st.l + st.beta * e * w, st.l);
 }

@@ -370,6 +370,9 @@ pub trait Transport: Copy + Send + Sync + 'static {
     );
     /// Lane `i`: the environment's radiance.
     fn set_environment<F: Float>(c: &mut Self::Colours, i: usize, ctx: &Ctx, lam: &Self::Lanes<F>);
+    /// Lane `i`: the linear RGB radiance `rgb` of an environment map, upsampled as an
+    /// illuminant by spectral transport.
+    fn set_map_radiance<F: Float>(c: &mut Self::Colours, i: usize, rgb: Vec3, lam: &Self::Lanes<F>);
     /// The recorded colours at every lane's wavelengths (lanes never set are unspecified).
     fn eval<F: Float, const N: usize>(c: &Self::Colours, lam: &Self::Lanes<F>) -> Chan<F, N>;
     /// The radiance `l` of each lane in `ended` (bit i: lane i) as linear sRGB for the film,
@@ -511,6 +514,10 @@ impl Transport for Rgb {
     #[inline(always)]
     fn set_environment<F: Float>(c: &mut RgbColours, i: usize, ctx: &Ctx, _: &()) {
         c.set(i, ctx.scene.environment);
+    }
+    #[inline(always)]
+    fn set_map_radiance<F: Float>(c: &mut RgbColours, i: usize, rgb: Vec3, _: &()) {
+        c.set(i, rgb);
     }
     #[inline(always)]
     fn eval<F: Float, const N: usize>(c: &RgbColours, _: &()) -> Chan<F, N> {
@@ -793,7 +800,23 @@ impl Transport for Spectral {
                 c.emitter(i, &ctx.spectral.point[light as usize], None, scale, lam)
             }
             LightSource::Environment => Self::set_environment(c, i, ctx, lam),
+            LightSource::EnvMap => Self::set_map_radiance(c, i, rgb, lam),
         }
+    }
+    #[inline(always)]
+    fn set_map_radiance<F: Float>(
+        c: &mut SpectralColours,
+        i: usize,
+        rgb: Vec3,
+        lam: &LaneWavelengths<F>,
+    ) {
+        c.emitter(
+            i,
+            &EmitSpec::Rgb(RgbIlluminant::from_rgb(rgb)),
+            None,
+            1.0,
+            lam,
+        );
     }
     #[inline(always)]
     fn set_environment<F: Float>(

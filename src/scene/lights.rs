@@ -13,6 +13,8 @@ pub enum LightKind {
     Area(u32),
     /// The constant environment: radiance from every direction.
     Environment(Vec3),
+    /// The environment map, [`Lights::map`].
+    EnvMap,
     /// A point or spot light (a delta light: never found by chance).
     Point(crate::components::PointLight),
 }
@@ -57,6 +59,9 @@ pub enum LightSource {
     },
     /// The constant environment.
     Environment,
+    /// The environment map: its radiance is the sample's linear RGB, upsampled as an
+    /// illuminant in spectral transport.
+    EnvMap,
 }
 
 /// The scene's emitters and the alias table that picks among them by power.
@@ -66,6 +71,8 @@ pub struct Lights {
     pub(crate) table: AliasTable,
     /// Index of the environment light, if the environment emits.
     pub environment: Option<u32>,
+    /// The environment map, when the environment is an image.
+    pub map: Option<std::sync::Arc<super::envmap::EnvMap>>,
 }
 
 impl Lights {
@@ -100,6 +107,18 @@ impl Lights {
                     pdf: pmf * crate::sampling::uniform_sphere_pdf(),
                     delta: false,
                     source: LightSource::Environment,
+                })
+            }
+            LightKind::EnvMap => {
+                let map = self.map.as_deref()?;
+                let (wi, radiance, pdf) = map.sample(u)?;
+                Some(LightSample {
+                    wi,
+                    point: None,
+                    radiance,
+                    pdf: pmf * pdf,
+                    delta: false,
+                    source: LightSource::EnvMap,
                 })
             }
             LightKind::Point(pl) => {
@@ -261,7 +280,7 @@ impl Lights {
                     density,
                 })
             }
-            LightKind::Environment(_) => None,
+            LightKind::Environment(_) | LightKind::EnvMap => None,
         }
     }
 
@@ -340,12 +359,26 @@ impl Lights {
         })
     }
 
-    /// Density of sampling direction `wi` towards the environment.
+    /// Density of sampling direction `wi` (unit length) towards the environment.
     #[inline]
-    pub fn pdf_environment(&self) -> f32 {
+    pub fn pdf_environment(&self, wi: Vec3) -> f32 {
         self.environment.map_or(0.0, |i| {
-            self.table.pmf(i as usize) * crate::sampling::uniform_sphere_pdf()
+            let pmf = self.table.pmf(i as usize);
+            match &self.map {
+                Some(map) => pmf * map.pdf(wi),
+                None => pmf * crate::sampling::uniform_sphere_pdf(),
+            }
         })
+    }
+
+    /// Radiance of the environment along `-d` (unit `d` pointing away from the scene), linear
+    /// RGB: the map's, or the constant `constant`.
+    #[inline]
+    pub fn environment_radiance(&self, d: Vec3, constant: Vec3) -> Vec3 {
+        match &self.map {
+            Some(map) => map.eval(d),
+            None => constant,
+        }
     }
 }
 

@@ -5,6 +5,7 @@
 //! integrator.
 
 pub mod effects;
+pub mod envmap;
 pub mod light_lanes;
 pub mod lights;
 pub mod packet;

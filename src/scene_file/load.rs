@@ -56,6 +56,8 @@ pub struct LoadedScene {
     pub environment: Vec3,
     /// What spectral transport evaluates for the environment.
     pub environment_spectrum: crate::spectrum::EmitterSpectrum,
+    /// The environment map, when the environment is an `Image`.
+    pub environment_map: Option<std::sync::Arc<crate::scene::envmap::EnvMap>>,
     /// Hash of the scene text and every override except the sample count, so renders of the
     /// same scene with different sample ranges can be matched.
     pub hash: u64,
@@ -421,8 +423,38 @@ fn build_world(
             }
         }
     }
+    let mut environment_map = None;
     let (environment, environment_spectrum) = match &scene.environment {
         Some(schema::Environment::Constant(e)) => (e.rgb, e.spectrum),
+        Some(schema::Environment::Image {
+            path: p,
+            scale,
+            rotate,
+        }) => {
+            let err = |message: String| SceneError::Entity {
+                path: path.to_path_buf(),
+                at: None,
+                key: "environment.path".into(),
+                entity: "environment".into(),
+                field: "path",
+                message,
+            };
+            let scene_dir = path.parent().unwrap_or(Path::new("."));
+            assets.check(scene_dir, &p.0).map_err(err)?;
+            let (img, _) = crate::imageio::read_image(&scene_dir.join(&p.0))
+                .map_err(|e| err(e.to_string()))?;
+            let map = crate::scene::envmap::EnvMap::new(
+                img.width,
+                img.height,
+                &img.pixels,
+                scale.map_or(1.0, |s| s.0),
+                rotate.map_or(Vec3::ZERO, |r| r.vec()),
+            )
+            .map_err(|e| err(e.to_string()))?
+            .with_source(&p.0);
+            environment_map = Some(std::sync::Arc::new(map));
+            (Vec3::ZERO, crate::spectrum::EmitterSpectrum::Rgb)
+        }
         None => (Vec3::ZERO, crate::spectrum::EmitterSpectrum::Rgb),
     };
 
@@ -752,6 +784,7 @@ fn build_world(
         render,
         environment,
         environment_spectrum,
+        environment_map,
         hash,
     })
 }

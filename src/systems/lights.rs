@@ -2,6 +2,7 @@
 
 use crate::geometry::Aabb;
 use crate::sampling::AliasTable;
+use crate::scene::envmap::EnvMap;
 use crate::scene::lights::luminance;
 use crate::scene::{LightKind, Lights, PrimKind, Primitives};
 use glam::Vec3;
@@ -12,6 +13,7 @@ pub fn gather_lights(
     world: &hecs::World,
     prims: &mut Primitives,
     environment: Vec3,
+    map: Option<&std::sync::Arc<EnvMap>>,
     scene_bounds: &Aabb,
 ) -> Lights {
     let mut lights = Vec::new();
@@ -50,7 +52,12 @@ pub fn gather_lights(
         power.push(std::f32::consts::PI * area * sides * luminance(e).max(1e-6));
     }
     let mut env_index = None;
-    if environment.max_element() > 0.0 {
+    let map = map.filter(|m| m.emits());
+    let (kind, radiance) = match map {
+        Some(m) => (LightKind::EnvMap, m.mean()),
+        None => (LightKind::Environment(environment), environment),
+    };
+    if radiance.max_element() > 0.0 {
         // As pbrt does, the environment's power is that of a disc the size of the scene
         // facing it from every direction.
         let r = if scene_bounds.is_empty() {
@@ -59,18 +66,19 @@ pub fn gather_lights(
             0.5 * scene_bounds.diagonal().length()
         };
         env_index = Some(lights.len() as u32);
-        lights.push(LightKind::Environment(environment));
+        lights.push(kind);
         power.push(
             4.0 * std::f32::consts::PI
                 * std::f32::consts::PI
                 * r
                 * r
-                * luminance(environment).max(1e-6),
+                * luminance(radiance).max(1e-6),
         );
     }
     Lights {
         table: AliasTable::new(&power),
         lights,
         environment: env_index,
+        map: map.cloned(),
     }
 }

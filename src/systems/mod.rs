@@ -47,7 +47,13 @@ pub fn prepare_frame(scene: &LoadedScene, params: &KdParams, frame: u32) -> Rend
     let accel = build_accel(&prims, params);
     let accel_seconds = t0.elapsed().as_secs_f64();
     let bounds: Aabb = accel.bounds();
-    let lights = gather_lights(&scene.world, &mut prims, scene.environment, &bounds);
+    let lights = gather_lights(
+        &scene.world,
+        &mut prims,
+        scene.environment,
+        scene.environment_map.as_ref(),
+        &bounds,
+    );
     let s = &scene.render;
     let camera_at = |t: f32| match &scene.camera_path {
         Some(p) => p.at(t, &scene.camera),

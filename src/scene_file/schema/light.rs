@@ -93,8 +93,28 @@ impl TryFrom<LightSpecRaw> for LightSpec {
 }
 
 /// Background radiance seen by escaping rays.
+///
+/// ```text
+/// Constant(Rgb(0.1, 0.1, 0.1))
+/// Image(path: "../assets/studio.exr", scale: 1.0, rotate: (0.0, 90.0, 0.0))
+/// ```
 #[derive(Clone, Debug, Deserialize)]
+#[serde(deny_unknown_fields)]
 pub enum Environment {
     /// The same radiance from every direction.
     Constant(Emission),
+    /// An equirectangular (latitude–longitude) map of linear RGB radiance, EXR or Radiance
+    /// HDR (PNG and JPEG are read as sRGB): `+y` up, the map's centre column facing `-z`,
+    /// turned by `rotate` (degrees about x, then y, then z, as a transform's rotation) and
+    /// multiplied by `scale`. A relative path is relative to the scene file.
+    Image {
+        /// The image file.
+        path: super::ImagePath,
+        /// Multiplies every texel; default 1.
+        #[serde(default)]
+        scale: Option<super::NonNegative>,
+        /// Rotation in degrees about x, y and z, applied x first; default zero.
+        #[serde(default)]
+        rotate: Option<V3>,
+    },
 }
