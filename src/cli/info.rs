@@ -63,25 +63,75 @@ pub(super) fn info(a: InfoArgs) -> Result<(), CliError> {
             )
         })
     };
-    if let Some(map) = &rs.lights.map {
+    // As the light table weighs them: the power an infinite light sends through a disc the
+    // size of the scene (radius r), π r² ∫ L dω, as luminance.
+    let bounds = rs.accel.bounds();
+    let r = if bounds.is_empty() {
+        1.0
+    } else {
+        0.5 * bounds.diagonal().length()
+    };
+    let power = |integral: glam::Vec3| {
+        format!(
+            "power {:.4e} W through the scene's disc (radius {r:.4})",
+            std::f32::consts::PI * r * r * crate::scene::lights::luminance(integral)
+        )
+    };
+    if let (Some(sky), Some(map)) = (&rs.lights.sky, &rs.lights.map) {
+        let p = sky.params();
+        let (w, h) = map.size();
+        let sun = if sky.has_sun() {
+            let c = sky.sun_rgb();
+            format!(
+                "; sun: disc of {:.4e} sr towards {:.4}, radiance ({:.4e}, {:.4e}, {:.4e}), \
+                 {}, sampled uniformly on its disc{}",
+                sky.sun_solid_angle(),
+                sky.sun_direction(),
+                c.x,
+                c.y,
+                c.z,
+                power(c * sky.sun_solid_angle()),
+                rs.lights.sun.map_or(String::new(), |i| format!(
+                    ", chosen with probability {:.3}",
+                    rs.lights.table.pmf(i as usize)
+                ))
+            )
+        } else {
+            "; no sun".into()
+        };
+        println!(
+            "environment: {p}; spectral Hosek–Wilkie sky, {}, sampled by its {w}×{h} \
+             tabulation's {}{}{sun}",
+            power(map.mean() * 4.0 * std::f32::consts::PI),
+            map.sampling(),
+            chosen(&rs.lights)
+        );
+    } else if let Some(map) = &rs.lights.map {
         let (w, h) = map.size();
         let m = map.mean();
         println!(
-            "environment: {map}; {w}×{h} texels, mean radiance ({:.4}, {:.4}, {:.4}); \
+            "environment: {map}; {w}×{h} texels, mean radiance ({:.4}, {:.4}, {:.4}), {}; \
              sampled by {}{}",
             m.x,
             m.y,
             m.z,
+            power(m * 4.0 * std::f32::consts::PI),
             map.sampling(),
             chosen(&rs.lights)
+        );
+    } else if let Some(sky) = &scene.sky {
+        println!(
+            "environment: {}; black (scale 0): it lights nothing",
+            sky.params()
         );
     } else if let Some(map) = &scene.environment_map {
         let (w, h) = map.size();
         println!("environment: {map}; {w}×{h} texels, all black: it lights nothing");
     } else if scene.environment != glam::Vec3::ZERO {
         println!(
-            "environment: Constant({}); sampled uniformly over the sphere{}",
+            "environment: Constant({}); {}; sampled uniformly over the sphere{}",
             EmissionSyntax(scene.environment, scene.environment_spectrum),
+            power(scene.environment * 4.0 * std::f32::consts::PI),
             chosen(&rs.lights)
         );
     }
@@ -100,15 +150,24 @@ pub(super) fn info(a: InfoArgs) -> Result<(), CliError> {
         .collect::<Vec<_>>()
         .join(", ");
     println!("primitives: {} ({counts})", rs.prims.len());
+    let kinds = &rs.lights.lights;
+    let count = |f: fn(&crate::scene::LightKind) -> bool| kinds.iter().filter(|k| f(k)).count();
+    let points = count(|k| matches!(k, crate::scene::LightKind::Point(_)));
     println!(
-        "lights: {} ({} area{})",
-        rs.lights.lights.len(),
-        rs.lights.lights.len() - rs.lights.environment.is_some() as usize,
+        "lights: {} ({} area{}{}{})",
+        kinds.len(),
+        count(|k| matches!(k, crate::scene::LightKind::Area(_))),
+        if points > 0 {
+            format!(", {points} point or spot")
+        } else {
+            String::new()
+        },
         if rs.lights.environment.is_some() {
             ", environment"
         } else {
             ""
-        }
+        },
+        if rs.lights.sun.is_some() { ", sun" } else { "" }
     );
     for (i, m) in rs.prims.meshes.iter().enumerate() {
         let b = m.shape.bounds();

@@ -62,6 +62,9 @@ fn escaped_map<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize>(
 ) {
     const MAX_W: usize = 16;
     let lights = &ctx.scene.lights;
+    if let Some(sky) = lights.sky.as_deref() {
+        return escaped_sky(ctx, st, miss, first, sky);
+    }
     let mut pdf = [0.0f32; MAX_W];
     let mut rgb = [[0.0f32; MAX_W]; 3];
     let mut e = T::colours();
@@ -85,6 +88,52 @@ fn escaped_map<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize>(
         Chan(std::array::from_fn(|k| F::load(&rgb[k])))
     };
     st.l = select_c(miss, st.l + st.beta * e * w, st.l);
+}
+
+/// [`escaped`] for the daylight sky: each lane evaluates the model along its direction, and
+/// the sun where the direction falls on its disc. Sky and sun are two lights, each with its
+/// own MIS weight, computed per lane here.
+#[inline(always)]
+fn escaped_sky<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize>(
+    ctx: &Ctx,
+    st: &mut Paths<F, T, N>,
+    miss: M<F>,
+    first: M<F>,
+    sky: &crate::scene::sky::Sky,
+) {
+    let lights = &ctx.scene.lights;
+    let mut e = T::colours();
+    let bits = miss.bits();
+    let first = first.bits();
+    for i in 0..F::WIDTH {
+        if bits >> i & 1 == 0 {
+            continue;
+        }
+        let d = st.d.lane(i).normalize_or_zero();
+        let on_sun = sky.on_sun(d);
+        let (w_sky, w_sun) = if first >> i & 1 != 0 {
+            (1.0, 1.0)
+        } else {
+            let prev = st.prev_pdf.lane(i);
+            let w = |light: f32| {
+                let (a, b) = (prev * prev, light * light);
+                if a + b == 0.0 { 0.0 } else { a / (a + b) }
+            };
+            let sun = if on_sun { w(lights.pdf_sun(d)) } else { 0.0 };
+            (w(lights.pdf_environment(d)), sun)
+        };
+        T::set_sky(
+            &mut e,
+            i,
+            sky,
+            d,
+            w_sky,
+            if on_sun { w_sun } else { 0.0 },
+            &st.lam,
+        );
+    }
+    let e = T::eval(&e, &st.lam);
+    st.l = select_c(miss, st.l + st.beta * e, st.l);
 }
 
 /// The radiance of the emitters the surface stage found, with its MIS weight.

@@ -14,6 +14,7 @@ use super::state::{MAX_W, mask_from_bits};
 use crate::components::ConductorIor;
 use crate::medium::{HomogeneousMedium, lanes};
 use crate::scene::lights::{LightSample, LightSource};
+use crate::scene::sky::Sky;
 use crate::scene::{LightKind, RenderScene};
 use crate::simd::{Float, Mask, UInt, V3};
 use crate::spectrum::N_LAMBDA;
@@ -373,6 +374,18 @@ pub trait Transport: Copy + Send + Sync + 'static {
     /// Lane `i`: the linear RGB radiance `rgb` of an environment map, upsampled as an
     /// illuminant by spectral transport.
     fn set_map_radiance<F: Float>(c: &mut Self::Colours, i: usize, rgb: Vec3, lam: &Self::Lanes<F>);
+    /// Lane `i`: `w_sky` times the sky's radiance along `-d` plus `w_sun` times the sun's
+    /// (spectral transport evaluates the model's spectra, RGB their linear sRGB).
+    #[allow(clippy::too_many_arguments)]
+    fn set_sky<F: Float>(
+        c: &mut Self::Colours,
+        i: usize,
+        sky: &Sky,
+        d: Vec3,
+        w_sky: f32,
+        w_sun: f32,
+        lam: &Self::Lanes<F>,
+    );
     /// The recorded colours at every lane's wavelengths (lanes never set are unspecified).
     fn eval<F: Float, const N: usize>(c: &Self::Colours, lam: &Self::Lanes<F>) -> Chan<F, N>;
     /// The radiance `l` of each lane in `ended` (bit i: lane i) as linear sRGB for the film,
@@ -518,6 +531,23 @@ impl Transport for Rgb {
     #[inline(always)]
     fn set_map_radiance<F: Float>(c: &mut RgbColours, i: usize, rgb: Vec3, _: &()) {
         c.set(i, rgb);
+    }
+    #[inline(always)]
+    fn set_sky<F: Float>(
+        c: &mut RgbColours,
+        i: usize,
+        sky: &Sky,
+        d: Vec3,
+        w_sky: f32,
+        w_sun: f32,
+        _: &(),
+    ) {
+        let sky_rgb = if w_sky != 0.0 {
+            sky.rgb(d) * w_sky
+        } else {
+            Vec3::ZERO
+        };
+        c.set(i, sky_rgb + sky.sun_rgb() * w_sun);
     }
     #[inline(always)]
     fn eval<F: Float, const N: usize>(c: &RgbColours, _: &()) -> Chan<F, N> {
@@ -800,7 +830,14 @@ impl Transport for Spectral {
                 c.emitter(i, &ctx.spectral.point[light as usize], None, scale, lam)
             }
             LightSource::Environment => Self::set_environment(c, i, ctx, lam),
-            LightSource::EnvMap => Self::set_map_radiance(c, i, rgb, lam),
+            LightSource::EnvMap { wi } => match ctx.scene.lights.sky.as_deref() {
+                Some(sky) => Self::set_sky(c, i, sky, wi, 1.0, 0.0, lam),
+                None => Self::set_map_radiance(c, i, rgb, lam),
+            },
+            LightSource::Sun => match ctx.scene.lights.sky.as_deref() {
+                Some(sky) => Self::set_sky(c, i, sky, Vec3::ZERO, 0.0, 1.0, lam),
+                None => c.sigmoid(i, &RgbSigmoid::grey(0.0)),
+            },
         }
     }
     #[inline(always)]
@@ -817,6 +854,25 @@ impl Transport for Spectral {
             1.0,
             lam,
         );
+    }
+    #[inline(always)]
+    fn set_sky<F: Float>(
+        c: &mut SpectralColours,
+        i: usize,
+        sky: &Sky,
+        d: Vec3,
+        w_sky: f32,
+        w_sun: f32,
+        lam: &LaneWavelengths<F>,
+    ) {
+        let lambda = lam.lane(i).lambda;
+        let a = if w_sky != 0.0 {
+            sky.radiance(d, lambda)
+        } else {
+            [0.0; N_LAMBDA]
+        };
+        let b = sky.sun_radiance(lambda);
+        c.tabulated(i, std::array::from_fn(|k| a[k] * w_sky + b[k] * w_sun));
     }
     #[inline(always)]
     fn set_environment<F: Float>(

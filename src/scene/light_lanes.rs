@@ -130,7 +130,8 @@ impl Lights {
                             scale: 0.0,
                         },
                         LightKind::Environment(_) => LightSource::Environment,
-                        LightKind::EnvMap => LightSource::EnvMap,
+                        // Sampled one lane at a time (`light_lanes` gives `None`).
+                        LightKind::EnvMap | LightKind::Sun => continue,
                     };
                     for (i, s) in sources.iter_mut().enumerate().take(F::WIDTH) {
                         if group >> i & 1 != 0 {
@@ -218,7 +219,7 @@ impl Lights {
                 return Some((s, F::zero()));
             }
             // Each lane walks the map's tables on its own.
-            LightKind::EnvMap => return None,
+            LightKind::EnvMap | LightKind::Sun => return None,
             LightKind::Point(pl) => {
                 let q = V3::<F>::splat(pl.position);
                 let d = q - p;

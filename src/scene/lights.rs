@@ -13,8 +13,10 @@ pub enum LightKind {
     Area(u32),
     /// The constant environment: radiance from every direction.
     Environment(Vec3),
-    /// The environment map, [`Lights::map`].
+    /// The environment map, [`Lights::map`] (or the sky tabulated, [`Lights::sky`]).
     EnvMap,
+    /// The sun's disc of [`Lights::sky`].
+    Sun,
     /// A point or spot light (a delta light: never found by chance).
     Point(crate::components::PointLight),
 }
@@ -59,9 +61,14 @@ pub enum LightSource {
     },
     /// The constant environment.
     Environment,
-    /// The environment map: its radiance is the sample's linear RGB, upsampled as an
-    /// illuminant in spectral transport.
-    EnvMap,
+    /// The environment map along `wi`: its radiance is the sample's linear RGB, upsampled as
+    /// an illuminant in spectral transport; or the sky's spectrum along `wi`.
+    EnvMap {
+        /// Unit direction towards the environment.
+        wi: Vec3,
+    },
+    /// The sun's disc: its spectrum in spectral transport.
+    Sun,
 }
 
 /// The scene's emitters and the alias table that picks among them by power.
@@ -71,8 +78,13 @@ pub struct Lights {
     pub(crate) table: AliasTable,
     /// Index of the environment light, if the environment emits.
     pub environment: Option<u32>,
-    /// The environment map, when the environment is an image.
+    /// The environment map, when the environment is an image (or a sky: its tabulation,
+    /// which only guides sampling).
     pub map: Option<std::sync::Arc<super::envmap::EnvMap>>,
+    /// The daylight sky, when the environment is a `Sky`.
+    pub sky: Option<std::sync::Arc<super::sky::Sky>>,
+    /// Index of the sun's light, if the sky has a sun.
+    pub sun: Option<u32>,
 }
 
 impl Lights {
@@ -112,13 +124,26 @@ impl Lights {
             LightKind::EnvMap => {
                 let map = self.map.as_deref()?;
                 let (wi, radiance, pdf) = map.sample(u)?;
+                // A sky's radiance is the model's, not its tabulation's.
+                let radiance = self.sky.as_deref().map_or(radiance, |sky| sky.rgb(wi));
                 Some(LightSample {
                     wi,
                     point: None,
                     radiance,
                     pdf: pmf * pdf,
                     delta: false,
-                    source: LightSource::EnvMap,
+                    source: LightSource::EnvMap { wi },
+                })
+            }
+            LightKind::Sun => {
+                let sky = self.sky.as_deref()?;
+                Some(LightSample {
+                    wi: sky.sample_sun(u),
+                    point: None,
+                    radiance: sky.sun_rgb(),
+                    pdf: pmf / sky.sun_solid_angle(),
+                    delta: false,
+                    source: LightSource::Sun,
                 })
             }
             LightKind::Point(pl) => {
@@ -280,7 +305,7 @@ impl Lights {
                     density,
                 })
             }
-            LightKind::Environment(_) | LightKind::EnvMap => None,
+            LightKind::Environment(_) | LightKind::EnvMap | LightKind::Sun => None,
         }
     }
 
@@ -371,13 +396,14 @@ impl Lights {
         })
     }
 
-    /// Radiance of the environment along `-d` (unit `d` pointing away from the scene), linear
-    /// RGB: the map's, or the constant `constant`.
+    /// Density of sampling direction `wi` (unit length) towards the sun (zero off its disc).
     #[inline]
-    pub fn environment_radiance(&self, d: Vec3, constant: Vec3) -> Vec3 {
-        match &self.map {
-            Some(map) => map.eval(d),
-            None => constant,
+    pub fn pdf_sun(&self, wi: Vec3) -> f32 {
+        match (self.sun, self.sky.as_deref()) {
+            (Some(i), Some(sky)) if sky.on_sun(wi) => {
+                self.table.pmf(i as usize) / sky.sun_solid_angle()
+            }
+            _ => 0.0,
         }
     }
 }

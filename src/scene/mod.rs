@@ -10,6 +10,7 @@ pub mod light_lanes;
 pub mod lights;
 pub mod packet;
 pub mod primitives;
+pub mod sky;
 
 pub use effects::{Effect, Effects};
 pub use lights::{LightKind, LightSample, Lights};

@@ -58,6 +58,9 @@ pub struct LoadedScene {
     pub environment_spectrum: crate::spectrum::EmitterSpectrum,
     /// The environment map, when the environment is an `Image`.
     pub environment_map: Option<std::sync::Arc<crate::scene::envmap::EnvMap>>,
+    /// The daylight sky, when the environment is a `Sky` (`environment_map` then holds its
+    /// tabulation, which guides sampling).
+    pub sky: Option<std::sync::Arc<crate::scene::sky::Sky>>,
     /// Hash of the scene text and every override except the sample count, so renders of the
     /// same scene with different sample ranges can be matched.
     pub hash: u64,
@@ -424,6 +427,7 @@ fn build_world(
         }
     }
     let mut environment_map = None;
+    let mut sky = None;
     let (environment, environment_spectrum) = match &scene.environment {
         Some(schema::Environment::Constant(e)) => (e.rgb, e.spectrum),
         Some(schema::Environment::Image {
@@ -453,6 +457,36 @@ fn build_world(
             .map_err(|e| err(e.to_string()))?
             .with_source(&p.0);
             environment_map = Some(std::sync::Arc::new(map));
+            (Vec3::ZERO, crate::spectrum::EmitterSpectrum::Rgb)
+        }
+        Some(schema::Environment::Sky {
+            sun_elevation,
+            sun_azimuth,
+            turbidity,
+            ground_albedo,
+            sun,
+            scale,
+        }) => {
+            let s = crate::scene::sky::Sky::new(crate::scene::sky::SkyParams {
+                sun_elevation: sun_elevation.0,
+                sun_azimuth: sun_azimuth.map_or(0.0, |a| a.0),
+                turbidity: turbidity.map_or(3.0, |t| t.0),
+                ground_albedo: ground_albedo.map_or(Vec3::splat(0.3), |a| a.0.vec()),
+                sun: sun.unwrap_or(true),
+                scale: scale.map_or(1.0, |s| s.0),
+            });
+            // 512 × 256 texels (0.7° each) guide the sky's sampling; the sun is a light of
+            // its own.
+            let map = s.tabulate(512, 256).map_err(|e| SceneError::Entity {
+                path: path.to_path_buf(),
+                at: None,
+                key: "environment".into(),
+                entity: "environment".into(),
+                field: "Sky",
+                message: e.to_string(),
+            })?;
+            environment_map = Some(std::sync::Arc::new(map));
+            sky = Some(std::sync::Arc::new(s));
             (Vec3::ZERO, crate::spectrum::EmitterSpectrum::Rgb)
         }
         None => (Vec3::ZERO, crate::spectrum::EmitterSpectrum::Rgb),
@@ -785,6 +819,7 @@ fn build_world(
         environment,
         environment_spectrum,
         environment_map,
+        sky,
         hash,
     })
 }

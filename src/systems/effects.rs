@@ -12,6 +12,7 @@ pub fn detect_effects(
     path: Option<&CameraPath>,
     shutter: (f32, f32),
     environment: &EmitterSpectrum,
+    sky: Option<&crate::scene::sky::Sky>,
 ) -> Effects {
     let mut fx = Effects::default();
     if camera.aperture_radius > 0.0 {
@@ -116,6 +117,9 @@ pub fn detect_effects(
     spectral.extend(emitters.into_iter().map(|(_, s)| s));
     if environment.is_spectral() {
         spectral.push(format!("environment: {}", environment.describe()));
+    }
+    if sky.is_some() {
+        spectral.push("environment: Sky (the Hosek–Wilkie spectral daylight model)".into());
     }
     if spectral.is_empty() {
         fx.set(

@@ -4,6 +4,7 @@ use crate::geometry::Aabb;
 use crate::sampling::AliasTable;
 use crate::scene::envmap::EnvMap;
 use crate::scene::lights::luminance;
+use crate::scene::sky::Sky;
 use crate::scene::{LightKind, Lights, PrimKind, Primitives};
 use glam::Vec3;
 
@@ -14,6 +15,7 @@ pub fn gather_lights(
     prims: &mut Primitives,
     environment: Vec3,
     map: Option<&std::sync::Arc<EnvMap>>,
+    sky: Option<&std::sync::Arc<Sky>>,
     scene_bounds: &Aabb,
 ) -> Lights {
     let mut lights = Vec::new();
@@ -52,19 +54,19 @@ pub fn gather_lights(
         power.push(std::f32::consts::PI * area * sides * luminance(e).max(1e-6));
     }
     let mut env_index = None;
+    // As pbrt does, an infinite light's power is that of a disc the size of the scene facing
+    // it from every direction (or from the sun's).
+    let r = if scene_bounds.is_empty() {
+        1.0
+    } else {
+        0.5 * scene_bounds.diagonal().length()
+    };
     let map = map.filter(|m| m.emits());
     let (kind, radiance) = match map {
         Some(m) => (LightKind::EnvMap, m.mean()),
         None => (LightKind::Environment(environment), environment),
     };
     if radiance.max_element() > 0.0 {
-        // As pbrt does, the environment's power is that of a disc the size of the scene
-        // facing it from every direction.
-        let r = if scene_bounds.is_empty() {
-            1.0
-        } else {
-            0.5 * scene_bounds.diagonal().length()
-        };
         env_index = Some(lights.len() as u32);
         lights.push(kind);
         power.push(
@@ -75,10 +77,20 @@ pub fn gather_lights(
                 * luminance(radiance).max(1e-6),
         );
     }
+    let mut sun = None;
+    if let Some(s) = sky.filter(|s| s.has_sun()) {
+        sun = Some(lights.len() as u32);
+        lights.push(LightKind::Sun);
+        power.push(
+            std::f32::consts::PI * r * r * s.sun_solid_angle() * luminance(s.sun_rgb()).max(1e-6),
+        );
+    }
     Lights {
         table: AliasTable::new(&power),
         lights,
         environment: env_index,
         map: map.cloned(),
+        sky: sky.cloned(),
+        sun,
     }
 }

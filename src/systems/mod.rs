@@ -40,6 +40,7 @@ pub fn prepare_frame(scene: &LoadedScene, params: &KdParams, frame: u32) -> Rend
         scene.camera_path.as_ref(),
         shutter,
         &scene.environment_spectrum,
+        scene.sky.as_deref(),
     );
     let mut prims = gather_primitives(&scene.world);
     prims.sweep = shutter;
@@ -52,6 +53,7 @@ pub fn prepare_frame(scene: &LoadedScene, params: &KdParams, frame: u32) -> Rend
         &mut prims,
         scene.environment,
         scene.environment_map.as_ref(),
+        scene.sky.as_ref(),
         &bounds,
     );
     let s = &scene.render;
@@ -96,6 +98,7 @@ impl RenderScene {
             scene.camera_path.as_ref(),
             shutter,
             &scene.environment_spectrum,
+            scene.sky.as_deref(),
         );
         let cam = match &scene.camera_path {
             Some(p) => p.at(shutter.0, &scene.camera),

@@ -97,6 +97,7 @@ impl TryFrom<LightSpecRaw> for LightSpec {
 /// ```text
 /// Constant(Rgb(0.1, 0.1, 0.1))
 /// Image(path: "../assets/studio.exr", scale: 1.0, rotate: (0.0, 90.0, 0.0))
+/// Sky(sun_elevation: 30.0, sun_azimuth: 120.0, turbidity: 3.0, ground_albedo: Rgb(0.3, 0.3, 0.3), sun: true, scale: 1.0)
 /// ```
 #[derive(Clone, Debug, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -116,5 +117,28 @@ pub enum Environment {
         /// Rotation in degrees about x, y and z, applied x first; default zero.
         #[serde(default)]
         rotate: Option<V3>,
+    },
+    /// A spectral daylight sky (Hosek & Wilkie 2012) and the sun's disc: black below the
+    /// horizon, `+y` up, azimuth measured from `-z` towards `+x` (as an `Image`'s columns).
+    Sky {
+        /// The sun's angle above the horizon in degrees, in [0, 90].
+        sun_elevation: super::SunElevation,
+        /// The sun's compass direction in degrees: 0 towards `-z`, 90 towards `+x`;
+        /// default 0.
+        #[serde(default)]
+        sun_azimuth: Option<super::Finite>,
+        /// Atmospheric turbidity in [1, 10] (2 a clear day, 10 haze); default 3.
+        #[serde(default)]
+        turbidity: Option<super::Turbidity>,
+        /// Reflectance of the ground under the sky, each channel in [0, 1]; default
+        /// `Rgb(0.3, 0.3, 0.3)`.
+        #[serde(default)]
+        ground_albedo: Option<super::Albedo>,
+        /// Whether the sun's disc shines; default true.
+        #[serde(default)]
+        sun: Option<bool>,
+        /// Multiplies sky and sun; default 1.
+        #[serde(default)]
+        scale: Option<super::NonNegative>,
     },
 }

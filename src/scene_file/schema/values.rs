@@ -49,6 +49,15 @@ macro_rules! checked_number {
 }
 
 checked_number!(
+    /// The sun's elevation above the horizon in degrees.
+    SunElevation(f32, "f32"), |x: f32| (0.0..=90.0).contains(&x), "in [0, 90] degrees");
+checked_number!(
+    /// Atmospheric turbidity of the sky model.
+    Turbidity(f32, "f32"), |x: f32| (1.0..=10.0).contains(&x), "in [1, 10]");
+checked_number!(
+    /// A finite number (an angle in degrees, say).
+    Finite(f32, "f32"), |x: f32| x.is_finite(), "a finite number");
+checked_number!(
     /// A finite number > 0.
     Positive(f32, "f32"), |x: f32| x.is_finite() && x > 0.0, "a finite number > 0");
 checked_number!(
