@@ -3,6 +3,8 @@
 //! drawn from the luminance distribution with its radiance and density), each over the same
 //! 4,096 arguments, so the figures are time per 4,096 results. The constant environment's
 //! lookup is a copy, its sample a uniform sphere warp: the map's cost is what these add.
+//! The daylight sky (elevation 30°, turbidity 3): the model's 11 bands along a direction (an
+//! RGB escape), its spectrum at 4 wavelengths (a spectral escape), and a sun sample.
 
 use criterion::{Criterion, Throughput, criterion_group, criterion_main};
 use glam::{Vec2, Vec3};
@@ -70,6 +72,43 @@ fn environment(c: &mut Criterion) {
             let mut acc = Vec3::ZERO;
             for u in &u {
                 acc += prism::sampling::square_to_uniform_sphere(black_box(*u));
+            }
+            acc
+        })
+    });
+    let sky = prism::scene::sky::Sky::new(prism::scene::sky::SkyParams {
+        sun_elevation: 30.0,
+        sun_azimuth: 120.0,
+        turbidity: 3.0,
+        ground_albedo: Vec3::splat(0.3),
+        sun: true,
+        scale: 1.0,
+    });
+    g.bench_function("sky: rgb along a direction", |b| {
+        b.iter(|| {
+            let mut acc = Vec3::ZERO;
+            for d in &d {
+                acc += sky.rgb(black_box(*d));
+            }
+            acc
+        })
+    });
+    g.bench_function("sky: spectrum at 4 wavelengths", |b| {
+        b.iter(|| {
+            let mut acc = 0.0f32;
+            for (d, u) in d.iter().zip(&u) {
+                let l = 360.0 + 470.0 * u.x;
+                let v = sky.radiance(black_box(*d), [l, l + 117.5, l + 235.0, l + 352.5]);
+                acc += v[0] + v[1] + v[2] + v[3];
+            }
+            acc
+        })
+    });
+    g.bench_function("sky: sun sample", |b| {
+        b.iter(|| {
+            let mut acc = Vec3::ZERO;
+            for u in &u {
+                acc += sky.sample_sun(black_box(*u));
             }
             acc
         })
