@@ -4,6 +4,7 @@
 
 mod common;
 
+use common::colour::lab;
 use common::render::{mean_where, run, scene};
 use glam::{Vec2, Vec3};
 use prism::scene::sky::{Sky, SkyParams};
@@ -175,20 +176,6 @@ fn a_plane_receives_the_sky_s_and_the_sun_s_irradiance() {
     }
 }
 
-/// CIE L*a*b* of XYZ against a white of luminance 1 (D65).
-fn lab(xyz: Vec3) -> Vec3 {
-    let white = Vec3::new(0.95047, 1.0, 1.08883);
-    let f = |t: f32| {
-        if t > 216.0 / 24389.0 {
-            t.cbrt()
-        } else {
-            (24389.0 / 27.0 * t + 16.0) / 116.0
-        }
-    };
-    let (fx, fy, fz) = (f(xyz.x / white.x), f(xyz.y / white.y), f(xyz.z / white.z));
-    Vec3::new(116.0 * fy - 16.0, 500.0 * (fx - fy), 200.0 * (fy - fz))
-}
-
 /// CIEDE2000 colour difference (Sharma, Wu and Dalal 2005, equations 1–22).
 fn delta_e2000(l1: Vec3, l2: Vec3) -> f32 {
     let (l1, l2) = (l1.as_dvec3(), l2.as_dvec3());
@@ -281,11 +268,8 @@ fn delta_e2000_matches_published_pairs() {
 /// ΔE2000 ≈ 1.2 at worst (5.5 at 256 samples, falling as 1/√n).
 #[test]
 fn spectral_and_rgb_skies_agree_within_delta_e_2() {
-    let m = glam::Mat3::from_cols(
-        Vec3::new(0.4124, 0.2126, 0.0193),
-        Vec3::new(0.3576, 0.7152, 0.1192),
-        Vec3::new(0.1805, 0.0722, 0.9505),
-    );
+    let xyz = prism::spectrum::linear_srgb_to_xyz;
+    let white = xyz(Vec3::ONE);
     for (e, a, t) in [(30.0, 120.0, 3.0), (5.0, 250.0, 6.0), (65.0, 10.0, 2.0)] {
         let text = format!(
             r#"Scene(
@@ -303,14 +287,14 @@ fn spectral_and_rgb_skies_agree_within_delta_e_2() {
         let (a_img, b_img) = (run(&spectral).image(), run(&rgb).image());
         let mut worst = 0.0f32;
         for (pa, pb) in a_img.pixels.iter().zip(&b_img.pixels) {
-            let (xa, xb) = (m * Vec3::from(*pa), m * Vec3::from(*pb));
+            let (xa, xb) = (xyz(Vec3::from(*pa)), xyz(Vec3::from(*pb)));
             if xb.y <= 0.0 {
                 assert!(xa.y.abs() < 1e-6, "spectral sky below the horizon");
                 continue;
             }
             // L* = 90 at Y = 0.7630.
             let k = 0.7630 / xb.y;
-            let de = delta_e2000(lab(xa * k), lab(xb * k));
+            let de = delta_e2000(lab(xa * k, white), lab(xb * k, white));
             worst = worst.max(de);
         }
         assert!(worst <= 2.0, "elevation {e}: worst ΔE2000 {worst}");

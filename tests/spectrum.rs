@@ -4,6 +4,7 @@
 mod common;
 
 use common::chi2::{Chi2, uniform_1d};
+use common::colour::lab;
 use common::quadrature::simpson;
 use glam::{Vec2, Vec3};
 use prism::spectrum::rgb2spec::{TABLE_RES, Z_DARK, table_cell, table_cell_rgb, z_node};
@@ -12,19 +13,6 @@ use rand_pcg::Pcg32;
 
 fn rng(seed: u64) -> Pcg32 {
     Pcg32::new(seed, 0xa02b_dbf7_bb3c_0a7c)
-}
-
-/// CIELAB (CIE 15:2004) of an XYZ colour relative to `white`.
-fn lab(xyz: Vec3, white: Vec3) -> Vec3 {
-    let f = |t: f32| {
-        if t > 216.0 / 24389.0 {
-            t.cbrt()
-        } else {
-            (24389.0 / 27.0 * t + 16.0) / 116.0
-        }
-    };
-    let (fx, fy, fz) = (f(xyz.x / white.x), f(xyz.y / white.y), f(xyz.z / white.z));
-    Vec3::new(116.0 * fy - 16.0, 500.0 * (fx - fy), 200.0 * (fy - fz))
 }
 
 /// ΔE*ab between two linear sRGB colours (sRGB white as reference).

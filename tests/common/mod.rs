@@ -2,6 +2,7 @@
 #![allow(dead_code)]
 
 pub mod chi2;
+pub mod colour;
 pub mod furnace;
 pub mod quadrature;
 pub mod render;
