@@ -93,6 +93,15 @@ pub(super) struct RenderArgs {
     /// First sample index per pixel, so separately rendered sample ranges never overlap.
     #[arg(long, default_value_t = 0)]
     pub(super) sample_offset: u32,
+    /// Sample batch B: sample indices from B·2²⁴ (--sample-offset B·16777216), a range no
+    /// adaptive render of another batch reaches; `prism merge` combines batches.
+    #[arg(long, conflicts_with = "sample_offset")]
+    pub(super) batch: Option<u32>,
+    /// Render until the image's estimated relative MSE is at most T (in (0, 1], e.g. 0.01),
+    /// spending samples where the noise is; --spp (the most any pixel gets) and --time-limit
+    /// cap it. Overrides render.target_error.
+    #[arg(long, value_name = "T", allow_negative_numbers = true)]
+    pub(super) target_error: Option<f64>,
     /// PNG exposure in stops.
     #[arg(long, default_value_t = 0.0, allow_negative_numbers = true, value_parser = parse_exposure)]
     pub(super) exposure: f32,
@@ -149,6 +158,7 @@ pub(super) struct ConvergeArgs {
     #[arg(long, default_value_t = 10.0)]
     pub(super) budget: f64,
     /// KEY=V1,V2,...: one curve per value (several --vary: every combination). Keys: spp,
+    /// target_error (one adaptive curve over the targets; `none` adds uniform sampling),
     /// max_depth, rr_depth, light_sampling, fresnel, wavelengths, sampler, force,
     /// kd.intersect_cost, kd.traversal_cost, kd.empty_bonus, kd.max_leaf_prims, or any --set key.
     #[arg(long, value_parser = parse_vary)]

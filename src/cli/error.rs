@@ -25,6 +25,12 @@ pub enum CliError {
     /// `--time-limit` is not a positive number of seconds.
     #[error("--time-limit must be a positive number of seconds, got {0}")]
     TimeLimit(f64),
+    /// `--target-error` is not a relative MSE in (0, 1].
+    #[error("--target-error must be a relative MSE in (0, 1], e.g. 0.01, got {0}")]
+    TargetError(f64),
+    /// `--batch` whose sample range runs past the last 32-bit sample index.
+    #[error("--batch must be in 0..=255 (batch B draws sample indices from B·2²⁴), got {0}")]
+    Batch(u32),
     /// `--sample-offset` plus the samples per pixel passes the last 32-bit sample index.
     #[error(
         "--sample-offset {offset} with {spp} samples per pixel runs past sample index \

@@ -57,8 +57,10 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<(u32, u64), CliError> {
         return Err(CliError::MergeNoParts);
     }
     let mut loaded: Vec<(PathBuf, Image, ImageMeta)> = Vec::with_capacity(parts.len());
+    let mut aux: Vec<film::Aux> = Vec::with_capacity(parts.len());
     for p in parts {
-        let (img, meta) = film::read_image(p)?;
+        let (img, meta, a) = film::read_image_aux(p)?;
+        aux.push(a);
         let meta = meta.ok_or_else(|| CliError::MergeNoHeader(p.clone()))?;
         if meta.spp == 0 {
             return Err(CliError::MergeEmptyPart(p.clone()));
@@ -101,9 +103,20 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<(u32, u64), CliError> {
         }
         loaded.push((p.clone(), img, meta));
     }
+    // An adaptive part (one with a count channel) draws indices `offset ..` up to half its
+    // largest count in each of its two halves; its pixels stop at different counts, so the
+    // ranges of adaptive parts leave gaps by design.
+    let adaptive = aux.iter().any(|a| a.count.is_some());
     let mut ranges: Vec<(u64, u64, &Path)> = loaded
         .iter()
-        .map(|(p, _, m)| (m.sample_offset, m.sample_offset + m.spp as u64, p.as_path()))
+        .zip(&aux)
+        .map(|((p, _, m), a)| {
+            let used = match a.count {
+                Some(_) => u64::from(m.spp).div_ceil(2),
+                None => u64::from(m.spp),
+            };
+            (m.sample_offset, m.sample_offset + used, p.as_path())
+        })
         .collect();
     ranges.sort();
     for w in ranges.windows(2) {
@@ -116,7 +129,7 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<(u32, u64), CliError> {
                 second_samples: (b0, b1),
             });
         }
-        if b0 > a1 {
+        if b0 > a1 && !adaptive {
             return Err(CliError::MergeGap {
                 missing: (a1, b0),
                 before: pa.to_path_buf(),
@@ -124,25 +137,41 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<(u32, u64), CliError> {
             });
         }
     }
-    let total: u64 = loaded.iter().map(|(_, _, m)| m.spp as u64).sum();
-    let total_u32 = u32::try_from(total).map_err(|_| CliError::MergeTooLarge(total))?;
     let (w, h) = (loaded[0].1.width, loaded[0].1.height);
-    let mut sums = vec![[0.0f64; 3]; w as usize * h as usize];
-    for (_, img, m) in &loaded {
-        let k = m.spp as f64;
-        for (s, p) in sums.iter_mut().zip(&img.pixels) {
-            for c in 0..3 {
-                s[c] += p[c] as f64 * k;
+    let n = w as usize * h as usize;
+    // Each pixel is weighted by its own sample count in each part.
+    let count = |k: usize, i: usize| -> u64 {
+        aux[k]
+            .count
+            .as_ref()
+            .map_or(u64::from(loaded[k].2.spp), |c| u64::from(c[i]))
+    };
+    let counts: Vec<u64> = (0..n)
+        .map(|i| (0..loaded.len()).map(|k| count(k, i)).sum())
+        .collect();
+    let total = if adaptive {
+        counts.iter().copied().max().unwrap_or(0)
+    } else {
+        loaded.iter().map(|(_, _, m)| m.spp as u64).sum()
+    };
+    let total_u32 = u32::try_from(total).map_err(|_| CliError::MergeTooLarge(total))?;
+    let mut sums = vec![[0.0f64; 3]; n];
+    for (k, (_, img, _)) in loaded.iter().enumerate() {
+        for (i, (s, p)) in sums.iter_mut().zip(&img.pixels).enumerate() {
+            let c = count(k, i) as f64;
+            for ch in 0..3 {
+                s[ch] += p[ch] as f64 * c;
             }
         }
     }
-    let inv = 1.0 / total as f64;
     let merged = Image {
         width: w,
         height: h,
         pixels: sums
             .iter()
-            .map(|s| {
+            .zip(&counts)
+            .map(|(s, &c)| {
+                let inv = 1.0 / c.max(1) as f64;
                 [
                     (s[0] * inv) as f32,
                     (s[1] * inv) as f32,
@@ -151,6 +180,27 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<(u32, u64), CliError> {
             })
             .collect(),
     };
+    // The merged error where every part has one: independent parts' variances add.
+    let errors: Option<Vec<f32>> = aux.iter().all(|a| a.error.is_some()).then(|| {
+        (0..n)
+            .map(|i| {
+                let parts: Vec<(f64, [f64; 3], f64)> = (0..loaded.len())
+                    .map(|k| {
+                        let p = loaded[k].1.pixels[i];
+                        let e = aux[k].error.as_ref().map_or(0.0, |e| f64::from(e[i]));
+                        (count(k, i) as f64, p.map(f64::from), e)
+                    })
+                    .collect();
+                film::estimate::combine_error(&parts) as f32
+            })
+            .collect()
+    });
+    let counts_u32: Option<Vec<u32>> = adaptive.then(|| {
+        counts
+            .iter()
+            .map(|&c| u32::try_from(c).unwrap_or(u32::MAX))
+            .collect()
+    });
     let meta = ImageMeta {
         spp: total_u32,
         sample_offset: ranges[0].0,
@@ -159,7 +209,16 @@ pub fn merge(parts: &[PathBuf], out: &Path) -> Result<(u32, u64), CliError> {
         complete: loaded.iter().all(|(_, _, m)| m.complete),
         settings: loaded[0].2.settings,
     };
-    film::write_image(out, &merged, &meta, &PngOptions::default())?;
+    film::write_image_aux(
+        out,
+        &merged,
+        &meta,
+        &PngOptions::default(),
+        &film::AuxChannels {
+            count: counts_u32.as_deref(),
+            error: errors.as_deref(),
+        },
+    )?;
     Ok((total_u32, ranges[0].0))
 }
 

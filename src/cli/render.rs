@@ -38,6 +38,17 @@ pub(super) fn render(a: RenderArgs) -> Result<(), CliError> {
     {
         return Err(CliError::Threads(t));
     }
+    if let Some(t) = a.target_error {
+        if !(t > 0.0 && t <= 1.0) {
+            return Err(CliError::TargetError(t));
+        }
+        extra.push(("render.target_error".to_string(), format!("{t:?}")));
+    }
+    if let Some(b) = a.batch
+        && b > 255
+    {
+        return Err(CliError::Batch(b));
+    }
     let scene = load_scene(&a.scene, &a.set, &extra)?;
     // From here on, SIGINT and SIGTERM stop the render and keep what it has.
     film::signals::install();
@@ -74,14 +85,29 @@ pub(super) fn render(a: RenderArgs) -> Result<(), CliError> {
     if a.stats {
         print_stats(&rs, &out, &output, pool.current_num_threads());
     } else if !a.quiet {
-        eprintln!(
-            "wrote {} ({} spp, {:.2} s)",
-            output.display(),
-            out.spp,
-            out.seconds
-        );
+        eprintln!("wrote {} ({})", output.display(), summary(&out));
     }
     Ok(())
+}
+
+use crate::integrator::MAX_ADAPTIVE_SPP;
+
+/// The first sample index: `--batch B` is `--sample-offset B·2²⁴`.
+fn sample_offset(a: &RenderArgs) -> u32 {
+    a.batch.map_or(a.sample_offset, |b| b << 24)
+}
+
+/// Samples and time of a render, and with a target error its estimate.
+fn summary(out: &integrator::RenderOutput) -> String {
+    match out.estimate {
+        Some(e) => format!(
+            "estimated relMSE {e:.3e}, {:.1} spp on average, {} at most, {:.2} s",
+            out.mean_spp(),
+            out.spp,
+            out.seconds
+        ),
+        None => format!("{} spp, {:.2} s", out.spp, out.seconds),
+    }
 }
 
 /// What a render stopped by a signal does with the samples it has.
@@ -132,25 +158,37 @@ fn render_to_file(
     label: &str,
     partial: Partial,
 ) -> Result<integrator::RenderOutput, CliError> {
-    let spp = rs.settings.spp;
+    let target = rs.settings.target_error;
+    // With a target error the scene's sample count is not a cap (scenes name a few dozen);
+    // only a count given on the command line is.
+    let spp_given = a.spp.is_some() || a.set.iter().any(|(k, _)| k == "render.spp");
+    let spp = match target {
+        Some(_) if !spp_given => MAX_ADAPTIVE_SPP,
+        _ => rs.settings.spp,
+    };
     let lanes = lanes_for(a, rs.settings.simd)?;
-    if u64::from(a.sample_offset) + u64::from(spp) > 1 << 32 {
-        return Err(CliError::SampleRange {
-            offset: a.sample_offset,
-            spp,
-        });
+    let offset = sample_offset(a);
+    // Adaptive renders draw `spp / 2` indices in each of their two halves.
+    let used = if target.is_some() {
+        spp.div_ceil(2)
+    } else {
+        spp
+    };
+    if u64::from(offset) + u64::from(used) > 1 << 32 {
+        return Err(CliError::SampleRange { offset, spp });
     }
     let opts = RenderOptions {
-        sample_offset: a.sample_offset,
+        sample_offset: offset,
         spp,
         time_limit: a.time_limit,
         lanes,
         monochromatic: None,
         stop: Some(film::signals::stop_flag()),
+        target_error: target,
     };
     let total = rs.settings.width as u64 * rs.settings.height as u64 * spp as u64;
-    let bar = progress::Progress::new(total, a.quiet, label);
-    let out = pool.install(|| integrator::render(rs, &opts, &|n| bar.add(n)));
+    let bar = progress::Progress::new(total, a.quiet, label, target);
+    let out = pool.install(|| integrator::render_observed(rs, &opts, &bar));
     bar.finish();
     let interrupted = |written: Option<PathBuf>| {
         let (signal, name) = film::signals::received().unwrap_or((2, "a signal"));
@@ -168,19 +206,25 @@ fn render_to_file(
     }
     let meta = ImageMeta {
         spp: out.spp,
-        sample_offset: a.sample_offset as u64,
+        sample_offset: u64::from(offset),
         scene_hash: scene.hash,
         simd: Some(out.lanes.width() as u32),
         complete: !out.interrupted,
         settings: Some(settings_hash(a, output)),
     };
-    film::write_image(
+    let errors: Vec<f32> = out.errors().iter().map(|&e| e as f32).collect();
+    let aux = film::AuxChannels {
+        count: (!out.counts.is_empty()).then_some(&out.counts[..]),
+        error: (!errors.is_empty()).then_some(&errors[..]),
+    };
+    film::write_image_aux(
         output,
         &out.image(),
         &meta,
         &PngOptions {
             exposure: a.exposure,
         },
+        &aux,
     )?;
     if out.interrupted {
         return Err(interrupted(Some(output.to_path_buf())));
@@ -200,9 +244,16 @@ fn resume_mismatch(a: &RenderArgs, scene: &LoadedScene, path: &Path, simd: u32) 
         return Some("it has no prism provenance (prism:* attributes)".into());
     };
     let r = &scene.render;
-    let spp_ok = match a.time_limit {
-        Some(_) => (1..=r.spp).contains(&m.spp),
-        None => m.spp == r.spp,
+    // Adaptive frames reach their target with any count up to the cap.
+    let adaptive = r.target_error.is_some();
+    let cap = if adaptive && a.spp.is_none() && !a.set.iter().any(|(k, _)| k == "render.spp") {
+        MAX_ADAPTIVE_SPP
+    } else {
+        r.spp
+    };
+    let spp_ok = match (a.time_limit, adaptive) {
+        (None, false) => m.spp == r.spp,
+        _ => (1..=cap).contains(&m.spp),
     };
     if !m.complete {
         Some(format!(
@@ -223,10 +274,11 @@ fn resume_mismatch(a: &RenderArgs, scene: &LoadedScene, path: &Path, simd: u32) 
             Some(w) => format!("it was rendered at SIMD width {w}, not {simd}"),
             None => "its SIMD width is not recorded".into(),
         })
-    } else if m.sample_offset != u64::from(a.sample_offset) {
+    } else if m.sample_offset != u64::from(sample_offset(a)) {
         Some(format!(
             "its samples start at {}, not {}",
-            m.sample_offset, a.sample_offset
+            m.sample_offset,
+            sample_offset(a)
         ))
     } else if !spp_ok {
         Some(format!("it has {} spp, not {}", m.spp, r.spp))
@@ -354,11 +406,11 @@ fn print_stats(rs: &RenderScene, out: &integrator::RenderOutput, output: &Path, 
     let s = &out.stats;
     let sps = s.samples as f64 / out.seconds.max(1e-9);
     eprintln!(
-        "image: {} ({}x{}, {} spp)",
+        "image: {} ({}x{}, {})",
         output.display(),
         out.width,
         out.height,
-        out.spp
+        summary(out)
     );
     eprintln!("time: {:.3} s on {} threads", out.seconds, threads);
     eprintln!(

@@ -20,7 +20,7 @@ pub struct Metrics {
 
 /// Keeps relMSE finite where the reference is black; 0.01 is the usual
 /// choice in the rendering literature.
-const RELMSE_EPSILON: f64 = 0.01;
+pub const RELMSE_EPSILON: f64 = 0.01;
 
 /// Compares `a` against the reference `b`. relMSE = mean over pixels and
 /// channels of (a − b)² / (b² + 0.01). Images with no pixels give all-zero

@@ -2,8 +2,9 @@
 //! files live in [`crate::imageio`], re-exported here.
 
 pub mod compare;
+pub mod estimate;
 pub mod tile;
 
 pub use crate::imageio::*;
 pub use compare::*;
-pub use tile::{Film, TILE, Tile, TileFilm, mean_image, tiles};
+pub use tile::{Film, HALF_B, TILE, Tile, TileFilm, TileWork, mean_image, tiles};

@@ -6,17 +6,23 @@ use std::path::Path;
 
 use exr::prelude::{self as ex, ReadChannels, ReadLayers, WritableImage};
 
-use super::{FilmError, Image, ImageMeta};
+use super::{Aux, AuxChannels, CHANNEL_COUNT, CHANNEL_ERROR, FilmError, Image, ImageMeta};
 
+#[cfg(test)]
 pub(super) fn encode_exr(path: &Path, img: &Image, meta: &ImageMeta) -> Result<Vec<u8>, FilmError> {
+    encode_exr_aux(path, img, meta, &AuxChannels::default())
+}
+
+/// [`encode_exr`] with the per-pixel `count` (u32) and `error` (f32) channels of an adaptive
+/// render, where given.
+pub(super) fn encode_exr_aux(
+    path: &Path,
+    img: &Image,
+    meta: &ImageMeta,
+    aux: &AuxChannels,
+) -> Result<Vec<u8>, FilmError> {
     let width = img.width as usize;
     let size = (width, img.height as usize);
-    let pixels = &img.pixels;
-    let channels = ex::SpecificChannels::rgb(move |pos: ex::Vec2<usize>| {
-        let [r, g, b] = pixels[pos.y() * width + pos.x()];
-        (r, g, b)
-    });
-
     let mut attributes = ex::LayerAttributes::default();
     for (name, value) in meta.attributes() {
         attributes.other.insert(
@@ -24,17 +30,61 @@ pub(super) fn encode_exr(path: &Path, img: &Image, meta: &ImageMeta) -> Result<V
             ex::AttributeValue::Text(ex::Text::from(value.as_str())),
         );
     }
-
-    // ZIP over 16-line blocks: lossless, compact, and readable everywhere.
-    let layer = ex::Layer::new(size, attributes, ex::Encoding::SMALL_LOSSLESS, channels);
+    let encode_error = |e: ex::Error| FilmError::Encode {
+        path: path.to_path_buf(),
+        message: e.to_string(),
+    };
     let mut out = Cursor::new(Vec::new());
-    ex::Image::from_layer(layer)
-        .write()
-        .to_buffered(&mut out)
-        .map_err(|e| FilmError::Encode {
-            path: path.to_path_buf(),
-            message: e.to_string(),
-        })?;
+    // ZIP over 16-line blocks: lossless, compact, and readable everywhere.
+    let enc = ex::Encoding::SMALL_LOSSLESS;
+    if aux.count.is_none() && aux.error.is_none() {
+        let pixels = &img.pixels;
+        let channels = ex::SpecificChannels::rgb(move |pos: ex::Vec2<usize>| {
+            let [r, g, b] = pixels[pos.y() * width + pos.x()];
+            (r, g, b)
+        });
+        ex::Image::from_layer(ex::Layer::new(size, attributes, enc, channels))
+            .write()
+            .to_buffered(&mut out)
+            .map_err(encode_error)?;
+    } else {
+        let n = img.pixels.len();
+        let check = |len: usize| -> Result<(), FilmError> {
+            if len == n {
+                Ok(())
+            } else {
+                Err(FilmError::Encode {
+                    path: path.to_path_buf(),
+                    message: format!("an extra channel has {len} values for {n} pixels"),
+                })
+            }
+        };
+        let channel = |c: usize| img.pixels.iter().map(|p| p[c]).collect::<Vec<f32>>();
+        let mut list = vec![
+            ex::AnyChannel::new("R", ex::FlatSamples::F32(channel(0))),
+            ex::AnyChannel::new("G", ex::FlatSamples::F32(channel(1))),
+            ex::AnyChannel::new("B", ex::FlatSamples::F32(channel(2))),
+        ];
+        if let Some(c) = aux.count {
+            check(c.len())?;
+            list.push(ex::AnyChannel::new(
+                CHANNEL_COUNT,
+                ex::FlatSamples::U32(c.to_vec()),
+            ));
+        }
+        if let Some(e) = aux.error {
+            check(e.len())?;
+            list.push(ex::AnyChannel::new(
+                CHANNEL_ERROR,
+                ex::FlatSamples::F32(e.to_vec()),
+            ));
+        }
+        let channels = ex::AnyChannels::sort(ex::SmallVec::from_vec(list));
+        ex::Image::from_layer(ex::Layer::new(size, attributes, enc, channels))
+            .write()
+            .to_buffered(&mut out)
+            .map_err(encode_error)?;
+    }
     let mut bytes = out.into_inner();
     sort_exr_header(&mut bytes);
     Ok(bytes)
@@ -131,10 +181,20 @@ pub(super) fn exr_header(
     ))
 }
 
+#[cfg(test)]
 pub(super) fn decode_exr(
     path: &Path,
     bytes: Vec<u8>,
 ) -> Result<(Image, Option<ImageMeta>), FilmError> {
+    decode_exr_aux(path, bytes).map(|(i, m, _)| (i, m))
+}
+
+/// [`decode_exr`], with the `count` and `error` channels of the chosen layer when it has
+/// them (full resolution, one value per pixel).
+pub(super) fn decode_exr_aux(
+    path: &Path,
+    bytes: Vec<u8>,
+) -> Result<(Image, Option<ImageMeta>, Aux), FilmError> {
     // The headers first: their data windows decide what the decoder allocates. (Headers
     // that do not parse are left to the decoder, whose error names the fault.)
     if let Ok(meta) = exr::meta::MetaData::read_from_buffered(Cursor::new(&bytes[..]), false) {
@@ -205,6 +265,28 @@ pub(super) fn decode_exr(
         })
     };
     let meta = ImageMeta::from_attributes(text);
+    let extra = |name: &str| {
+        find(layer, name)
+            .map(|i| &list[i].sample_data)
+            .filter(|d| d.len() == pixels.len())
+    };
+    let aux = Aux {
+        count: extra(CHANNEL_COUNT).map(|d| match d {
+            ex::FlatSamples::U32(v) => v.clone(),
+            // Written by other tools as floats: whole, non-negative counts only.
+            other => other
+                .values_as_f32()
+                .map(|x| {
+                    if x.is_finite() && x >= 0.0 {
+                        x as u32
+                    } else {
+                        0
+                    }
+                })
+                .collect(),
+        }),
+        error: extra(CHANNEL_ERROR).map(|d| d.values_as_f32().collect()),
+    };
 
     Ok((
         Image {
@@ -213,6 +295,7 @@ pub(super) fn decode_exr(
             pixels,
         },
         meta,
+        aux,
     ))
 }
 

@@ -255,6 +255,40 @@ pub fn write_image(
     meta: &ImageMeta,
     png: &PngOptions,
 ) -> Result<(), FilmError> {
+    write_image_aux(path, img, meta, png, &AuxChannels::default())
+}
+
+/// The EXR channel of an adaptive render's per-pixel sample counts (u32).
+pub const CHANNEL_COUNT: &str = "count";
+/// The EXR channel of an adaptive render's per-pixel estimated relMSE (f32).
+pub const CHANNEL_ERROR: &str = "error";
+
+/// Per-pixel channels an EXR carries besides R, G and B (a PNG has no room for them).
+#[derive(Clone, Copy, Debug, Default)]
+pub struct AuxChannels<'a> {
+    /// Samples in each pixel ([`CHANNEL_COUNT`]).
+    pub count: Option<&'a [u32]>,
+    /// Each pixel's estimated relMSE ([`CHANNEL_ERROR`]).
+    pub error: Option<&'a [f32]>,
+}
+
+/// The [`AuxChannels`] read back from a file (`None` where absent).
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Aux {
+    /// Samples in each pixel.
+    pub count: Option<Vec<u32>>,
+    /// Each pixel's estimated relMSE.
+    pub error: Option<Vec<f32>>,
+}
+
+/// [`write_image`] with extra per-pixel channels, written to EXR files only.
+pub fn write_image_aux(
+    path: &Path,
+    img: &Image,
+    meta: &ImageMeta,
+    png: &PngOptions,
+    aux: &AuxChannels,
+) -> Result<(), FilmError> {
     let format = ImageFormat::from_path(path)?;
     img.validate(Some(path))?;
     if img.width == 0 || img.height == 0 {
@@ -266,7 +300,7 @@ pub fn write_image(
     }
     let bytes = match format {
         ImageFormat::Png => raster::encode_png(path, img, meta, png)?,
-        ImageFormat::Exr => exr::encode_exr(path, img, meta)?,
+        ImageFormat::Exr => exr::encode_exr_aux(path, img, meta, aux)?,
     };
     write_atomic(path, &bytes)
 }
@@ -311,6 +345,11 @@ pub fn read_header(path: &Path) -> Result<ImageHeader, FilmError> {
 ///   alpha is dropped. Metadata is `None`.
 /// - HDR (Radiance): already linear, returned as is. Metadata is `None`.
 pub fn read_image(path: &Path) -> Result<(Image, Option<ImageMeta>), FilmError> {
+    read_image_aux(path).map(|(i, m, _)| (i, m))
+}
+
+/// [`read_image`], with an EXR's [`Aux`] channels (empty for other formats).
+pub fn read_image_aux(path: &Path) -> Result<(Image, Option<ImageMeta>, Aux), FilmError> {
     let format = ReadFormat::from_path(path)?;
     let bytes =
         crate::files::read_bounded(path, crate::files::MAX_IMAGE_BYTES).map_err(|error| {
@@ -320,7 +359,9 @@ pub fn read_image(path: &Path) -> Result<(Image, Option<ImageMeta>), FilmError> 
             }
         })?;
     match format {
-        ReadFormat::Exr => exr::decode_exr(path, bytes),
-        ReadFormat::Raster(f) => decode_raster(path, bytes, f, ColorSpace::Srgb).map(|i| (i, None)),
+        ReadFormat::Exr => exr::decode_exr_aux(path, bytes),
+        ReadFormat::Raster(f) => {
+            decode_raster(path, bytes, f, ColorSpace::Srgb).map(|i| (i, None, Aux::default()))
+        }
     }
 }

@@ -5,7 +5,7 @@ use super::ctx::{Ctx, DIM_FILM, DIM_LENS, DIM_TIME};
 use super::state::{C, M, MAX_W, Paths, U, mask_from_bits, select_c};
 use super::transport::{ChannelArray, Transport};
 use crate::components::camera::CameraFrame;
-use crate::film::Tile;
+use crate::film::{Tile, TileWork};
 use crate::sampling::warp::lanes as warp;
 use crate::scene::primitives::NO_MEDIUM;
 use crate::simd::{Float, Mask, UInt, V3, math};
@@ -58,10 +58,25 @@ pub fn camera_rays<F: Float, const MOTION: bool>(
     y: F::U32,
     index: F::U32,
 ) -> CameraRays<F> {
+    let pixel = y
+        .wrapping_mul(<F::U32 as UInt>::splat(ctx.width))
+        .wrapping_add(x);
+    camera_rays_keyed::<F, MOTION>(ctx, x, y, pixel, index)
+}
+
+/// [`camera_rays`] with the sampler keyed by `pixel` (the pixel's number, with
+/// [`crate::film::HALF_B`] set for the second of two independent halves).
+#[inline(always)]
+pub fn camera_rays_keyed<F: Float, const MOTION: bool>(
+    ctx: &Ctx,
+    x: F::U32,
+    y: F::U32,
+    pixel: F::U32,
+    index: F::U32,
+) -> CameraRays<F> {
     type U<F> = <F as Float>::U32;
     let scene = ctx.scene;
     let s = &scene.settings;
-    let pixel = y.wrapping_mul(U::<F>::splat(ctx.width)).wrapping_add(x);
     let sampler = &ctx.sampler;
     let time = if MOTION {
         let (open, close) = scene.shutter;
@@ -164,6 +179,13 @@ pub fn lens_point_lanes<F: Float>(ux: F, uy: F, blades: u32) -> (F, F) {
     (c0 * b0 + c1 * b1, s0 * b0 + s1 * b1)
 }
 
+/// Where a tile's pass stands: the tile pixel being sampled and its next sample of the pass.
+#[derive(Clone, Copy, Default)]
+pub(super) struct Cursor {
+    p: usize,
+    k: u32,
+}
+
 /// Starts new paths in the dead lanes, from the tile's next samples in pixel-major order
 /// (every width takes them in the same order).
 #[inline(always)]
@@ -175,27 +197,34 @@ pub(super) fn refill<
 >(
     ctx: &Ctx,
     tile: &Tile,
-    s0: u32,
-    spp: usize,
-    total: usize,
-    next: &mut usize,
+    work: &TileWork,
+    cur: &mut Cursor,
     st: &mut Paths<F, T, N>,
 ) {
     let mut x = [0u32; MAX_W];
     let mut y = [0u32; MAX_W];
     let mut idx = [0u32; MAX_W];
+    let mut half = [0u32; MAX_W];
     let mut fresh = 0u32;
     let alive = st.alive.bits();
+    let pixels = tile.pixels();
     for i in 0..F::WIDTH {
-        if alive >> i & 1 == 0 && *next < total {
-            let (p, k) = (*next / spp, *next % spp);
-            (x[i], y[i]) = tile.pixel(p);
-            idx[i] = s0 + k as u32;
-            fresh |= 1 << i;
-            *next += 1;
-            st.medium[i] = ctx.scene.camera_medium;
-            st.segments[i] = 0;
+        if alive >> i & 1 != 0 {
+            continue;
         }
+        while cur.p < pixels && cur.k >= work.range(cur.p).1 {
+            cur.p += 1;
+            cur.k = 0;
+        }
+        if cur.p >= pixels {
+            break;
+        }
+        (x[i], y[i]) = tile.pixel(cur.p);
+        (idx[i], half[i]) = work.index(work.range(cur.p).0 + cur.k);
+        cur.k += 1;
+        fresh |= 1 << i;
+        st.medium[i] = ctx.scene.camera_medium;
+        st.segments[i] = 0;
     }
     if fresh == 0 {
         return;
@@ -208,11 +237,14 @@ pub(super) fn refill<
         U::<F>::from_fn(|i| y[i]),
         U::<F>::from_fn(|i| idx[i]),
     );
-    let cam = camera_rays::<F, MOTION>(ctx, xl, yl, il);
+    // The half bit keys the sampler apart (every dimension, the camera's too); the film
+    // clears it again.
+    let pixel =
+        yl.wrapping_mul(U::<F>::splat(ctx.width)).wrapping_add(xl) | U::<F>::from_fn(|i| half[i]);
+    let cam = camera_rays_keyed::<F, MOTION>(ctx, xl, yl, pixel, il);
     st.o = V3::select(fm, cam.o, st.o);
     st.d = V3::select(fm, cam.d, st.d);
     st.time = F::select(fm, cam.time, st.time);
-    let pixel = yl.wrapping_mul(U::<F>::splat(ctx.width)).wrapping_add(xl);
     let lam = T::wavelengths::<F>(ctx, pixel, il);
     st.beta = select_c(fm, T::initial_beta(&lam), st.beta);
     st.lam = T::select_lanes(fm, lam, st.lam);

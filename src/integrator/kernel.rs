@@ -17,13 +17,13 @@ use super::state::{C, M, MAX_W, Paths, U};
 use super::surface::{CLASS_BOUNDARY, CLASS_NONE};
 use super::transport::{ChannelArray, Transport};
 use super::{RenderStats, emission, generate, material, media, surface};
-use crate::film::{Tile, TileFilm};
+use crate::film::{Tile, TileFilm, TileWork};
 use crate::geometry::offset_ray_origin_lanes;
 use crate::scene::primitives::NO_MEDIUM;
 use crate::simd::{Float, Mask, UInt, V3};
 
-/// Renders samples `s0..s1` of every pixel of `tile` with packets of `F::WIDTH` paths, adding
-/// each finished path's radiance to `film`.
+/// Renders the samples `work` names of every pixel of `tile` with packets of `F::WIDTH`
+/// paths, adding each finished path's radiance to `film`.
 #[inline(always)]
 pub fn render_tile<
     F: Float,
@@ -34,14 +34,11 @@ pub fn render_tile<
 >(
     ctx: &Ctx,
     tile: &Tile,
-    s0: u32,
-    s1: u32,
+    work: &TileWork,
     film: &mut TileFilm,
     stats: &mut RenderStats,
 ) {
-    let spp = (s1 - s0) as usize;
-    let total = tile.pixels() * spp;
-    let mut next = 0usize;
+    let mut cursor = generate::Cursor::default();
     let zero3 = V3::<F>::zero();
     let mut st = Paths::<F, T, N> {
         o: zero3,
@@ -65,7 +62,7 @@ pub fn render_tile<
     let scene = ctx.scene;
     let max_depth = U::<F>::splat(ctx.max_depth);
     loop {
-        generate::refill::<F, T, N, MOTION>(ctx, tile, s0, spp, total, &mut next, &mut st);
+        generate::refill::<F, T, N, MOTION>(ctx, tile, work, &mut cursor, &mut st);
         let started = st.alive;
         if started.none() {
             break;

@@ -46,7 +46,7 @@ pub mod transport;
 
 pub use ctx::Ctx;
 
-use crate::film::{Film, Tile, TileFilm, tiles};
+use crate::film::{Film, Tile, TileFilm, TileWork, tiles};
 use crate::scene::{Effect, RenderScene};
 use crate::simd::Lanes;
 use rayon::prelude::*;
@@ -100,6 +100,10 @@ pub struct RenderOptions {
     /// Once this is set, tiles not yet started are skipped and the pass in flight is dropped:
     /// the output holds the whole passes before it ([`RenderOutput::interrupted`]).
     pub stop: Option<&'static AtomicBool>,
+    /// Render in passes until the image's estimated relMSE is at most this, spending samples
+    /// where the estimated error is ([`crate::film::estimate`]); `spp` becomes the most any
+    /// pixel may receive. `None` renders `spp` samples in every pixel.
+    pub target_error: Option<f64>,
 }
 
 impl RenderOptions {
@@ -112,7 +116,39 @@ impl RenderOptions {
             lanes,
             monochromatic: None,
             stop: None,
+            target_error: None,
         }
+    }
+}
+
+/// The most samples a pixel of an adaptive render may receive when nothing lower caps it:
+/// 2²⁴ in each of its halves, the index range of one sample batch.
+pub const MAX_ADAPTIVE_SPP: u32 = 1 << 25;
+
+/// What the render reports after each whole pass (besides the samples of each tile).
+#[derive(Clone, Copy, Debug)]
+pub struct PassReport {
+    /// Samples rendered so far, over the whole image.
+    pub samples: u64,
+    /// Seconds since the render began.
+    pub seconds: f64,
+    /// The image's estimated relMSE after the pass (with a target error).
+    pub estimate: Option<f64>,
+}
+
+/// Receives a render's progress: samples as tiles finish, and each pass's report.
+pub trait Observer: Sync {
+    /// `n` more samples are done.
+    fn samples(&self, n: u64);
+    /// A pass is done.
+    fn pass(&self, _report: &PassReport) {}
+}
+
+struct SampleCount<'a>(&'a (dyn Fn(u64) + Sync));
+
+impl Observer for SampleCount<'_> {
+    fn samples(&self, n: u64) {
+        (self.0)(n)
     }
 }
 
@@ -164,8 +200,15 @@ pub struct RenderOutput {
     pub height: u32,
     /// Sum of the radiance of every sample, per pixel (row-major, top row first).
     pub sums: Vec<[f64; 3]>,
-    /// Samples per pixel actually rendered (fewer than asked under a time limit).
+    /// Samples per pixel actually rendered (fewer than asked under a time limit); with a
+    /// target error, the most any pixel received.
     pub spp: u32,
+    /// With a target error, each pixel's sample count (row-major); empty otherwise.
+    pub counts: Vec<u32>,
+    /// With a target error, each pixel's sums over its half-B samples; empty otherwise.
+    pub half: Vec<[f64; 3]>,
+    /// With a target error, the image's estimated relMSE at the end.
+    pub estimate: Option<f64>,
     /// Counters of the render.
     pub stats: RenderStats,
     /// Wall-clock seconds the render took.
@@ -177,9 +220,40 @@ pub struct RenderOutput {
 }
 
 impl RenderOutput {
-    /// The image: sums divided by the sample count.
+    /// The image: sums divided by the sample count (each pixel's own, with a target error).
     pub fn image(&self) -> crate::film::Image {
-        crate::film::mean_image(self.width, self.height, &self.sums, self.spp)
+        if self.counts.is_empty() {
+            return crate::film::mean_image(self.width, self.height, &self.sums, self.spp);
+        }
+        crate::film::Image {
+            width: self.width,
+            height: self.height,
+            pixels: self
+                .sums
+                .iter()
+                .zip(&self.counts)
+                .map(|(s, &n)| {
+                    let k = 1.0 / f64::from(n.max(1));
+                    [(s[0] * k) as f32, (s[1] * k) as f32, (s[2] * k) as f32]
+                })
+                .collect(),
+        }
+    }
+
+    /// With a target error, each pixel's estimated relMSE; empty otherwise.
+    pub fn errors(&self) -> Vec<f64> {
+        if self.half.is_empty() {
+            return Vec::new();
+        }
+        crate::film::estimate::pixel_errors(&self.sums, &self.half, &self.counts, self.width)
+    }
+
+    /// Mean samples per pixel.
+    pub fn mean_spp(&self) -> f64 {
+        if self.counts.is_empty() {
+            return f64::from(self.spp);
+        }
+        self.counts.iter().map(|&n| f64::from(n)).sum::<f64>() / self.counts.len().max(1) as f64
     }
 }
 
@@ -189,6 +263,15 @@ pub fn render(
     scene: &RenderScene,
     opts: &RenderOptions,
     progress: &(dyn Fn(u64) + Sync),
+) -> RenderOutput {
+    render_observed(scene, opts, &SampleCount(progress))
+}
+
+/// [`render`], reporting to an [`Observer`] (which also hears of each pass).
+pub fn render_observed(
+    scene: &RenderScene,
+    opts: &RenderOptions,
+    progress: &dyn Observer,
 ) -> RenderOutput {
     let fx = &scene.effects;
     let (s, m, mo) = (
@@ -219,8 +302,7 @@ pub fn describe_lanes(asked: Lanes) -> String {
 /// type `dispatch` picks.
 struct TileKernel<'a, 'c, T, const N: usize, const MOTION: bool, const MEDIA: bool> {
     ctx: &'a Ctx<'c>,
-    s0: u32,
-    s1: u32,
+    work: TileWork<'a>,
     film: &'a mut TileFilm,
     stats: &'a mut RenderStats,
     transport: PhantomData<T>,
@@ -238,7 +320,7 @@ impl<
     fn run<F: crate::simd::Float>(self) {
         let tile = self.film.tile;
         kernel::render_tile::<F, T, N, MOTION, MEDIA>(
-            self.ctx, &tile, self.s0, self.s1, self.film, self.stats,
+            self.ctx, &tile, &self.work, self.film, self.stats,
         )
     }
 }
@@ -251,9 +333,8 @@ fn render_with<
 >(
     scene: &RenderScene,
     opts: &RenderOptions,
-    progress: &(dyn Fn(u64) + Sync),
+    progress: &dyn Observer,
 ) -> RenderOutput {
-    let lanes = opts.lanes;
     let spectral = if scene.effects.has(Effect::Spectral) {
         transport::SpectralData::new(scene)
     } else {
@@ -261,43 +342,83 @@ fn render_with<
     };
     let mut ctx = Ctx::new(scene, scene.effects.has(Effect::Lens)).with_spectral(&spectral);
     ctx.monochromatic = opts.monochromatic;
-    let (w, h) = (scene.settings.width, scene.settings.height);
-    let tiles: Vec<Tile> = tiles(w, h);
-    let mut image = Film::new(w, h);
-    let mut stats = RenderStats::default();
-    let start = Instant::now();
-    let mut done = 0u32;
-    let stopped = || opts.stop.is_some_and(|s| s.load(Ordering::Relaxed));
-    let mut interrupted = false;
-    // With a time limit, passes double in size so the limit is checked often early on and
-    // rarely later; without one, they follow `pass_sizes`.
-    let mut pass = 1;
-    let mut sizes = pass_sizes(opts.spp);
-    while done < opts.spp {
-        let n = if opts.time_limit.is_some() {
-            pass.min(opts.spp - done)
-        } else {
-            sizes.next().unwrap_or(opts.spp - done)
-        };
-        let s0 = opts.sample_offset + done;
-        let t_pass = Instant::now();
-        let results: Vec<(TileFilm, RenderStats)> = tiles
+    let pass = Passes::<T, N, MEDIA, MOTION> {
+        ctx: &ctx,
+        opts,
+        tiles: tiles(scene.settings.width, scene.settings.height),
+        progress,
+        transport: PhantomData,
+    };
+    match opts.target_error {
+        Some(t) => pass.adaptive(t),
+        None => pass.uniform(),
+    }
+}
+
+/// The pass loop of one render: its tiles, rendered in parallel, one pass at a time.
+struct Passes<'a, 'c, T, const N: usize, const MEDIA: bool, const MOTION: bool> {
+    ctx: &'a Ctx<'c>,
+    opts: &'a RenderOptions,
+    tiles: Vec<Tile>,
+    progress: &'a dyn Observer,
+    transport: PhantomData<T>,
+}
+
+/// Uniform passes come first, doubling from [`WARMUP_FIRST`] to at most [`WARMUP_LAST`]
+/// samples per pixel while the estimate is above twice the target: a pixel's neighbourhood needs
+/// a few samples in each half before it can steer anything, and near the target a doubling
+/// would overshoot it.
+const WARMUP_FIRST: u32 = 8;
+/// See [`WARMUP_FIRST`].
+const WARMUP_LAST: u32 = 32;
+
+impl<
+    T: transport::Transport<S: transport::ChannelArray<N>>,
+    const N: usize,
+    const MEDIA: bool,
+    const MOTION: bool,
+> Passes<'_, '_, T, N, MEDIA, MOTION>
+{
+    fn stopped(&self) -> bool {
+        self.opts.stop.is_some_and(|s| s.load(Ordering::Relaxed))
+    }
+
+    /// One pass over every tile; `work(i)` names tile `i`'s samples. `None` if a stop came
+    /// during the pass (which is then dropped).
+    fn run<'w>(
+        &self,
+        image: &mut Film,
+        stats: &mut RenderStats,
+        work: &(dyn Fn(usize) -> TileWork<'w> + Sync),
+    ) -> Option<()> {
+        let (w, split) = (self.ctx.width, !image.half.is_empty());
+        let results: Vec<(TileFilm, RenderStats)> = self
+            .tiles
             .par_iter()
-            .map(|tile| {
-                let mut film = TileFilm::new(*tile, w);
+            .enumerate()
+            .map(|(i, tile)| {
+                let mut film = if split {
+                    TileFilm::with_halves(*tile, w)
+                } else {
+                    TileFilm::new(*tile, w)
+                };
                 let mut st = RenderStats::default();
-                if stopped() {
+                if self.stopped() {
                     // The pass is dropped: skip what is left of it.
+                    return (film, st);
+                }
+                let work = work(i);
+                let samples = work.total(tile.pixels());
+                if samples == 0 {
                     return (film, st);
                 }
                 // Each width runs inside its entry point, so the lane code it inlines uses
                 // that width's instructions (width 1: the CPU's FMA).
                 crate::simd::dispatch(
-                    lanes,
+                    self.opts.lanes,
                     TileKernel::<T, N, MOTION, MEDIA> {
-                        ctx: &ctx,
-                        s0,
-                        s1: s0 + n,
+                        ctx: self.ctx,
+                        work,
                         film: &mut film,
                         stats: &mut st,
                         transport: PhantomData,
@@ -306,38 +427,195 @@ fn render_with<
                 st.samples += film.samples;
                 st.dropped += film.dropped;
                 st.revolution += crate::scene::primitives::take_revolution_stats();
-                progress(tile.pixels() as u64 * n as u64);
+                self.progress.samples(samples);
                 (film, st)
             })
             .collect();
-        if stopped() {
-            interrupted = true;
-            break;
+        if self.stopped() {
+            return None;
         }
         for (film, st) in &results {
             image.add_tile(film);
             stats.add(st);
         }
-        done += n;
-        if let Some(limit) = opts.time_limit {
-            let elapsed = start.elapsed().as_secs_f64();
-            let per_sample = t_pass.elapsed().as_secs_f64() / n as f64;
-            let next = (pass * 2).min(opts.spp - done);
-            if elapsed + per_sample * next as f64 > limit {
-                break;
-            }
-            pass *= 2;
+        Some(())
+    }
+
+    fn output(&self, image: Film, stats: RenderStats, spp: u32, start: Instant) -> RenderOutput {
+        RenderOutput {
+            width: image.width,
+            height: image.height,
+            sums: image.sums,
+            spp,
+            counts: Vec::new(),
+            half: image.half,
+            estimate: None,
+            stats,
+            seconds: start.elapsed().as_secs_f64(),
+            lanes: self.opts.lanes,
+            interrupted: false,
         }
     }
-    RenderOutput {
-        width: w,
-        height: h,
-        sums: image.sums,
-        spp: done,
-        stats,
-        seconds: start.elapsed().as_secs_f64(),
-        lanes,
-        interrupted,
+
+    /// `spp` samples in every pixel.
+    fn uniform(&self) -> RenderOutput {
+        let opts = self.opts;
+        let (w, h) = (self.ctx.width, self.ctx.scene.settings.height);
+        let mut image = Film::new(w, h);
+        let mut stats = RenderStats::default();
+        let start = Instant::now();
+        let mut done = 0u32;
+        let mut interrupted = false;
+        // With a time limit, passes double in size so the limit is checked often early on and
+        // rarely later; without one, they follow `pass_sizes`.
+        let mut pass = 1;
+        let mut sizes = pass_sizes(opts.spp);
+        while done < opts.spp {
+            let n = if opts.time_limit.is_some() {
+                pass.min(opts.spp - done)
+            } else {
+                sizes.next().unwrap_or(opts.spp - done)
+            };
+            let t_pass = Instant::now();
+            let work = TileWork {
+                offset: opts.sample_offset,
+                uniform: (done, n),
+                per_pixel: None,
+                split: false,
+            };
+            if self.run(&mut image, &mut stats, &|_| work).is_none() {
+                interrupted = true;
+                break;
+            }
+            done += n;
+            self.progress.pass(&PassReport {
+                samples: u64::from(done) * u64::from(w) * u64::from(h),
+                seconds: start.elapsed().as_secs_f64(),
+                estimate: None,
+            });
+            if let Some(limit) = opts.time_limit {
+                let elapsed = start.elapsed().as_secs_f64();
+                let per_sample = t_pass.elapsed().as_secs_f64() / n as f64;
+                let next = (pass * 2).min(opts.spp - done);
+                if elapsed + per_sample * next as f64 > limit {
+                    break;
+                }
+                pass *= 2;
+            }
+        }
+        let mut out = self.output(image, stats, done, start);
+        out.interrupted = interrupted;
+        out
+    }
+
+    /// Passes until the estimated relMSE is at most `target`: uniform ones first
+    /// ([`WARMUP_FIRST`]), then adaptive ones ([`crate::film::estimate::allocate`]).
+    fn adaptive(&self, target: f64) -> RenderOutput {
+        use crate::film::estimate;
+        let opts = self.opts;
+        let (w, h) = (self.ctx.width, self.ctx.scene.settings.height);
+        let mut image = Film::with_halves(w, h);
+        let mut counts = vec![0u32; image.sums.len()];
+        let mut stats = RenderStats::default();
+        let start = Instant::now();
+        // Even, so both halves always hold as many samples.
+        let cap = opts.spp.max(2) & !1;
+        let mut interrupted = false;
+        let mut estimate = f64::INFINITY;
+        let mut total = 0u64;
+        let mut warm = Some(WARMUP_FIRST.min(cap));
+        loop {
+            let t_pass = Instant::now();
+            let before = total;
+            // Per tile, per pixel: (first sample, samples this pass).
+            let ranges: Vec<Vec<(u32, u32)>> = if let Some(end) = warm {
+                let done = counts.first().copied().unwrap_or(0);
+                self.tiles
+                    .iter()
+                    .map(|t| vec![(done, end.saturating_sub(done)); t.pixels()])
+                    .collect()
+            } else {
+                let errors = estimate::pixel_errors(&image.sums, &image.half, &counts, w);
+                let near = estimate < 2.0 * target;
+                let add = estimate::allocate(
+                    &errors,
+                    &counts,
+                    w,
+                    h,
+                    &estimate::Allocation {
+                        target,
+                        aim: 0.9,
+                        cap,
+                        growth: if near { 1.25 } else { 2.0 },
+                    },
+                );
+                self.tiles
+                    .iter()
+                    .map(|t| {
+                        (0..t.pixels())
+                            .map(|p| {
+                                let (x, y) = t.pixel(p);
+                                let i = (y * w + x) as usize;
+                                (counts[i], add[i])
+                            })
+                            .collect()
+                    })
+                    .collect()
+            };
+            let pass_samples: u64 = ranges.iter().flatten().map(|r| u64::from(r.1)).sum();
+            if pass_samples == 0 {
+                break;
+            }
+            let offset = opts.sample_offset;
+            let ok = self.run(&mut image, &mut stats, &|i| TileWork {
+                offset,
+                uniform: (0, 0),
+                per_pixel: Some(&ranges[i]),
+                split: true,
+            });
+            if ok.is_none() {
+                interrupted = true;
+                break;
+            }
+            for (t, r) in self.tiles.iter().zip(&ranges) {
+                for (p, &(_, n)) in r.iter().enumerate() {
+                    let (x, y) = t.pixel(p);
+                    counts[(y * w + x) as usize] += n;
+                }
+            }
+            total += pass_samples;
+            estimate = estimate::image_error(&estimate::pixel_errors(
+                &image.sums,
+                &image.half,
+                &counts,
+                w,
+            ));
+            self.progress.pass(&PassReport {
+                samples: total,
+                seconds: start.elapsed().as_secs_f64(),
+                estimate: Some(estimate),
+            });
+            if estimate <= target {
+                break;
+            }
+            warm = warm
+                .map(|n| (n * 2).min(cap))
+                .filter(|&n| n <= WARMUP_LAST && estimate > 2.0 * target && n > counts[0]);
+            if let Some(limit) = opts.time_limit {
+                // The next pass is at most twice this one's samples.
+                let per_sample = t_pass.elapsed().as_secs_f64() / (total - before) as f64;
+                let elapsed = start.elapsed().as_secs_f64();
+                if elapsed + per_sample * 2.0 * pass_samples as f64 > limit {
+                    break;
+                }
+            }
+        }
+        let spp = counts.iter().copied().max().unwrap_or(0);
+        let mut out = self.output(image, stats, spp, start);
+        out.counts = counts;
+        out.estimate = Some(estimate);
+        out.interrupted = interrupted;
+        out
     }
 }
 

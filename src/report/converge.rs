@@ -24,6 +24,8 @@ pub struct Config {
     pub kd: KdParams,
     /// Sample counts to render instead of the doubling ladder.
     pub spp: Option<Vec<u32>>,
+    /// Target errors to render to (adaptively) instead of a ladder of sample counts.
+    pub targets: Option<Vec<f64>>,
 }
 
 /// One rung of a configuration's ladder.
@@ -43,6 +45,10 @@ pub struct Row {
     pub ssim: f64,
     /// relMSE without the worst 0.1 % of pixels ([`film::relmse_trimmed`]).
     pub relmse_trimmed: f64,
+    /// The target relMSE of an adaptive rung.
+    pub target: Option<f64>,
+    /// The render's own estimate of its relMSE (adaptive rungs), to set beside `relmse`.
+    pub estimate: Option<f64>,
 }
 
 /// What `prism converge` is asked to do.
@@ -88,6 +94,22 @@ pub const VARY_ALIASES: &[(&str, &str)] = &[
     ("equiangular", "render.integrator.equiangular"),
 ];
 
+/// The `--vary` keys of the target error: a ladder of targets, as `spp` is of counts.
+const TARGET_KEYS: [&str; 2] = ["target_error", "render.target_error"];
+
+/// A `--vary target_error` value: a relMSE in (0, 1], or `none` for uniform sampling.
+fn parse_target(v: &str) -> Result<Option<f64>, String> {
+    if matches!(v, "none" | "off" | "uniform") {
+        return Ok(None);
+    }
+    match v.parse::<f64>() {
+        Ok(t) if t > 0.0 && t <= 1.0 => Ok(Some(t)),
+        _ => Err(format!(
+            "--vary target_error: '{v}' is not a relative MSE in (0, 1] (or none)"
+        )),
+    }
+}
+
 fn apply_knob(c: &mut Config, key: &str, value: &str) -> Result<(), String> {
     let num = |v: &str| -> Result<f32, String> {
         v.parse::<f32>()
@@ -130,12 +152,56 @@ fn apply_knob(c: &mut Config, key: &str, value: &str) -> Result<(), String> {
 /// The configurations: the cartesian product of every `--vary` list (the scene as it is when
 /// there is none).
 pub fn configs(vary: &[(String, Vec<String>)]) -> Result<Vec<Config>, String> {
+    // Target errors make one ladder per configuration of the other knobs (`none` adds the
+    // uniform configuration beside it).
+    let (target_vary, vary): (Vec<_>, Vec<_>) = vary
+        .iter()
+        .cloned()
+        .partition(|(k, _)| TARGET_KEYS.contains(&k.as_str()));
+    let mut targets = Vec::new();
+    let mut uniform_too = false;
+    for v in target_vary.iter().flat_map(|(_, v)| v) {
+        match parse_target(v)? {
+            Some(t) => targets.push(t),
+            None => uniform_too = true,
+        }
+    }
+    let mut out = configs_of(&vary)?;
+    if targets.is_empty() {
+        return Ok(out);
+    }
+    let mut with = Vec::new();
+    for c in out.drain(..) {
+        if uniform_too {
+            let mut u = c.clone();
+            u.name = join_name(&c.name, "uniform");
+            with.push(u);
+        }
+        let mut a = c.clone();
+        a.name = join_name(&c.name, "adaptive");
+        a.targets = Some(targets.clone());
+        with.push(a);
+    }
+    Ok(with)
+}
+
+/// `base` and `tag`, or `tag` alone in place of `baseline`.
+fn join_name(base: &str, tag: &str) -> String {
+    if base.is_empty() || base == "baseline" {
+        tag.to_string()
+    } else {
+        format!("{base} {tag}")
+    }
+}
+
+fn configs_of(vary: &[(String, Vec<String>)]) -> Result<Vec<Config>, String> {
     let mut out = vec![Config {
         name: String::new(),
         overrides: Vec::new(),
         force: Vec::new(),
         kd: KdParams::default(),
         spp: None,
+        targets: None,
     }];
     for (key, values) in vary {
         if values.is_empty() {
@@ -174,6 +240,7 @@ pub fn configs(vary: &[(String, Vec<String>)]) -> Result<Vec<Config>, String> {
             force: Vec::new(),
             kd: KdParams::default(),
             spp: Some(ladder),
+            targets: None,
         }]);
     }
     if out.len() == 1 && out[0].name.is_empty() {
@@ -204,6 +271,19 @@ fn timed_render(
     spp: u32,
     offset: u32,
 ) -> Result<(Image, f64), String> {
+    timed_render_to(scene, kd, force, spp, offset, None).map(|(i, t, _)| (i, t))
+}
+
+/// [`timed_render`], adaptive to `target` when given (with `spp` as the cap): the image, the
+/// seconds, and the render's output (for its sample counts and estimate).
+fn timed_render_to(
+    scene: &LoadedScene,
+    kd: &KdParams,
+    force: &[Effect],
+    spp: u32,
+    offset: u32,
+    target: Option<f64>,
+) -> Result<(Image, f64, crate::integrator::RenderOutput), String> {
     let t0 = Instant::now();
     let mut rs = systems::prepare(scene, kd);
     for e in force {
@@ -218,10 +298,11 @@ fn timed_render(
             lanes: crate::simd::Lanes::auto(),
             monochromatic: None,
             stop: None,
+            target_error: target,
         },
         &|_| {},
     );
-    Ok((out.image(), t0.elapsed().as_secs_f64()))
+    Ok((out.image(), t0.elapsed().as_secs_f64(), out))
 }
 
 /// The reference image: given, cached from an earlier run, or rendered now in two
@@ -298,14 +379,19 @@ pub fn converge(opts: &ConvergeOptions) -> Result<ConvergeResult, String> {
                 reference.width, reference.height, c.name, scene.render.width, scene.render.height
             ));
         }
-        let ladder: Vec<u32> = match &c.spp {
-            Some(l) => l.clone(),
-            None => (0..20).map(|k| 1u32 << k).collect(),
+        // A ladder of sample counts, or of target errors (adaptive, uncapped).
+        let ladder: Vec<(u32, Option<f64>)> = match (&c.targets, &c.spp) {
+            (Some(t), _) => t
+                .iter()
+                .map(|&t| (crate::integrator::MAX_ADAPTIVE_SPP, Some(t)))
+                .collect(),
+            (None, Some(l)) => l.iter().map(|&n| (n, None)).collect(),
+            (None, None) => (0..20).map(|k| (1u32 << k, None)).collect(),
         };
         let mut spent = 0.0;
         let mut last: Option<(u32, f64)> = None;
-        for &spp in &ladder {
-            if c.spp.is_none() {
+        for &(spp, target) in &ladder {
+            if c.spp.is_none() && target.is_none() {
                 // Stop before a rung that would overrun the budget (time grows with spp).
                 if let Some((s0, t0)) = last
                     && spent + t0 * spp as f64 / s0 as f64 > opts.budget
@@ -316,31 +402,45 @@ pub fn converge(opts: &ConvergeOptions) -> Result<ConvergeResult, String> {
                     break;
                 }
             }
-            let (img, secs) = timed_render(&scene, &c.kd, &c.force, spp, 0)?;
+            let (img, secs, out) = timed_render_to(&scene, &c.kd, &c.force, spp, 0, target)?;
             spent += secs;
             last = Some((spp, secs));
             let m = film::compare(&img, &reference).map_err(|e| e.to_string())?;
             let row = Row {
                 config: c.name.clone(),
-                spp,
+                spp: out.mean_spp().round() as u32,
                 seconds: secs,
                 rmse: m.rmse,
                 relmse: m.relmse,
                 ssim: super::ssim::ssim(&img, &reference),
                 relmse_trimmed: film::relmse_trimmed(&img, &reference, TRIM),
+                target,
+                estimate: out.estimate,
             };
             if !opts.quiet {
+                let est = row
+                    .estimate
+                    .map_or(String::new(), |e| format!(" (estimated {e:.3e})"));
                 eprintln!(
-                    "{}: {} spp, {:.3} s, relMSE {:.3e}",
+                    "{}: {} spp, {:.3} s, relMSE {:.3e}{est}",
                     row.config, row.spp, row.seconds, row.relmse
                 );
             }
             rows.push(row);
         }
     }
-    let mut csv = String::from("config,spp,seconds,rmse,relmse,ssim,relmse_trimmed\n");
+    // The two columns of adaptive rungs only when there are any: the file keeps its old
+    // form for studies without them.
+    let adaptive = rows.iter().any(|r| r.estimate.is_some());
+    let mut csv = String::from("config,spp,seconds,rmse,relmse,ssim,relmse_trimmed");
+    csv.push_str(if adaptive {
+        ",target_error,estimated_relmse\n"
+    } else {
+        "\n"
+    });
+    let opt = |x: Option<f64>| x.map_or(String::new(), |x| format!("{x:.6e}"));
     for r in &rows {
-        writeln!(
+        write!(
             csv,
             "{},{},{:.6},{:.6e},{:.6e},{:.6},{:.6e}",
             csv_field(&r.config),
@@ -349,9 +449,13 @@ pub fn converge(opts: &ConvergeOptions) -> Result<ConvergeResult, String> {
             r.rmse,
             r.relmse,
             r.ssim,
-            r.relmse_trimmed
+            r.relmse_trimmed,
         )
         .unwrap();
+        if adaptive {
+            write!(csv, ",{},{}", opt(r.target), opt(r.estimate)).unwrap();
+        }
+        csv.push('\n');
     }
     film::write_atomic(&opts.out.join("converge.csv"), csv.as_bytes())
         .map_err(|e| e.to_string())?;
@@ -523,6 +627,24 @@ fn summary(scene: &Path, rows: &[Row], names: &[String], ref_est: Option<f64>) -
         .unwrap();
     }
     s.push_str("\nrelMSE = mean((x − r)² / (r² + 0.01)) over pixels and channels; seconds include scene preparation. Rare bright samples (caustics found by chance) can dominate relMSE for thousands of samples; the trimmed column drops the 0.1 % of pixels with the largest error.\n");
+    let adaptive: Vec<&Row> = rows.iter().filter(|r| r.estimate.is_some()).collect();
+    if !adaptive.is_empty() {
+        s.push_str("\n## Estimated against true error\n\nAdaptive renders stop when their own estimate of relMSE (two independent halves per pixel) reaches the target; the true relMSE is measured against the reference (whose own noise, above, adds to it).\n\n| configuration | target | estimated relMSE | true relMSE | true / estimated | mean spp | seconds |\n|---|---|---|---|---|---|---|\n");
+        for r in adaptive {
+            let e = r.estimate.unwrap_or(f64::NAN);
+            writeln!(
+                s,
+                "| {} | {} | {e:.3e} | {:.3e} | {:.2} | {} | {:.2} |",
+                r.config,
+                r.target.map_or("–".into(), |t| format!("{t:.1e}")),
+                r.relmse,
+                r.relmse / e,
+                r.spp,
+                r.seconds
+            )
+            .unwrap();
+        }
+    }
     s
 }
 

@@ -18,6 +18,7 @@ fn ns_per_sample(rs: &crate::scene::RenderScene, spp: u32, runs: usize) -> f64 {
         lanes: crate::simd::Lanes::auto(),
         monochromatic: None,
         stop: None,
+        target_error: None,
     };
     let mut t: Vec<f64> = (0..runs)
         .map(|_| {

@@ -29,7 +29,12 @@ where
     root.fill(&WHITE).map_err(|e| err(&e))?;
     let pos = |v: f64| v > 0.0 && v.is_finite();
     let ts: Vec<f64> = rows.iter().map(|r| r.seconds).filter(|v| pos(*v)).collect();
-    let es: Vec<f64> = rows.iter().map(|r| r.relmse).filter(|v| pos(*v)).collect();
+    let es: Vec<f64> = rows
+        .iter()
+        .flat_map(|r| [Some(r.relmse), r.estimate])
+        .flatten()
+        .filter(|v| pos(*v))
+        .collect();
     if ts.is_empty() || es.is_empty() {
         return Err("nothing to plot: no rung has a positive time and error".into());
     }
@@ -71,6 +76,24 @@ where
         chart
             .draw_series(pts.iter().map(|p| Circle::new(*p, 3, c.filled())))
             .map_err(|e| err(&e))?;
+        // The render's own estimate beside the true error: hollow markers, thin line.
+        let est: Vec<(f64, f64)> = rows
+            .iter()
+            .filter(|r| &r.config == name && pos(r.seconds))
+            .filter_map(|r| r.estimate.filter(|e| pos(*e)).map(|e| (r.seconds, e)))
+            .collect();
+        if !est.is_empty() {
+            chart
+                .draw_series(LineSeries::new(est.clone(), c.stroke_width(1)))
+                .map_err(|e| err(&e))?
+                .label(format!("{name} (estimated)"))
+                .legend(move |(x, y)| {
+                    PathElement::new(vec![(x, y), (x + 20, y)], c.stroke_width(1))
+                });
+            chart
+                .draw_series(est.iter().map(|p| Circle::new(*p, 4, c.stroke_width(1))))
+                .map_err(|e| err(&e))?;
+        }
     }
     chart
         .configure_series_labels()

@@ -38,6 +38,8 @@ pub struct RenderSettings {
     pub filter: schema::Filter,
     /// The lane width the scene asks for (`--simd` overrides it).
     pub simd: crate::simd::SimdChoice,
+    /// Render until the estimated relMSE is at most this (`--target-error` overrides it).
+    pub target_error: Option<f64>,
 }
 
 /// A loaded scene: the world of entities and the resources beside it.
@@ -141,7 +143,9 @@ fn load_text(
         if !patch::is_entity_path(k) {
             apply_override(&mut scene, k, v)?;
         }
-        if k != "render.spp" {
+        // Like the sample count, the target decides how many samples, not which: batches
+        // rendered to different targets still merge.
+        if k != "render.spp" && k != "render.target_error" {
             hash = fnv1a(k.as_bytes(), hash);
             hash = fnv1a(v.as_bytes(), hash);
         }
@@ -258,6 +262,7 @@ pub const OVERRIDE_KEYS: &[&str] = &[
     "camera.lens.focus_distance",
     "camera.lens.blades",
     "render.newton_tolerance",
+    "render.target_error",
     "environment",
 ];
 
@@ -311,6 +316,7 @@ pub fn apply_override(scene: &mut schema::Scene, key: &str, value: &str) -> Resu
         }
         "camera.lens.blades" => c.lens.get_or_insert_with(lens).blades = val(key, value)?,
         "render.newton_tolerance" => r.newton_tolerance = Some(val(key, value)?),
+        "render.target_error" => r.target_error = Some(val(key, value)?),
         "environment" => scene.environment = Some(val(key, value)?),
         _ => {
             return Err(SceneError::Override {
@@ -392,6 +398,7 @@ fn build_world(
         equiangular: r.integrator.equiangular,
         filter: r.filter,
         simd: r.simd,
+        target_error: r.target_error.map(|t| t.0),
     };
     let camera_path = scene.animation.as_ref().map(|a| CameraPath {
         fps: a.fps,

@@ -1,6 +1,6 @@
 //! `render:` settings: image size, samples, depth, seed, filter and the integrator's options.
 
-use super::{ImageDim, MaxDepth, Positive, Spp, Wavelengths};
+use super::{ImageDim, MaxDepth, Positive, Spp, TargetError, Wavelengths};
 use serde::{Deserialize, Serialize};
 
 /// The `render:` settings; every field is optional.
@@ -36,6 +36,11 @@ pub struct Render {
     /// absent by default.
     #[serde(default)]
     pub newton_tolerance: Option<Positive>,
+    /// Render until the image's estimated relMSE is at most this, in (0, 1]; `spp` is then
+    /// ignored unless given on the command line, where it caps every pixel. Absent by
+    /// default (`--target-error` overrides it).
+    #[serde(default)]
+    pub target_error: Option<TargetError>,
 }
 
 /// The most pixels a film may have: 2²⁸ (16384 × 16384), the bound on decoded images too.
@@ -90,6 +95,7 @@ impl Default for Render {
             filter: Filter::default(),
             simd: Default::default(),
             newton_tolerance: None,
+            target_error: None,
         }
     }
 }

@@ -55,6 +55,10 @@ checked_number!(
     /// Atmospheric turbidity of the sky model.
     Turbidity(f32, "f32"), |x: f32| (1.0..=10.0).contains(&x), "in [1, 10]");
 checked_number!(
+    /// The relMSE a render may stop at: in (0, 1].
+    TargetError(f64, "f64"), |x: f64| x > 0.0 && x <= 1.0,
+    "a relative MSE in (0, 1], e.g. 0.01");
+checked_number!(
     /// A finite number (an angle in degrees, say).
     Finite(f32, "f32"), |x: f32| x.is_finite(), "a finite number");
 checked_number!(
