@@ -143,3 +143,59 @@ fn forcing_media_or_textures_on_a_scene_without_them_changes_nothing_beyond_nois
         }
     }
 }
+
+/// `--vary target_error=none,...` makes a uniform curve and one adaptive curve over the
+/// targets, whose rows carry the render's own estimate beside the true error (CSV, summary),
+/// and whose true error falls as the target does.
+#[test]
+fn converge_sets_the_estimate_beside_the_true_error() {
+    let d = tempfile::tempdir().unwrap();
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.ron");
+    let out = Command::cargo_bin("prism")
+        .unwrap()
+        .args([
+            "converge",
+            scene.to_str().unwrap(),
+            "--size",
+            "32x32",
+            "--reference-spp",
+            "1024",
+            "--budget",
+            "0.5",
+            "--quiet",
+        ])
+        .args(["--vary", "target_error=none,0.05,0.01", "-o"])
+        .arg(d.path())
+        .output()
+        .unwrap();
+    assert!(
+        out.status.success(),
+        "{}",
+        String::from_utf8_lossy(&out.stderr)
+    );
+    let csv = std::fs::read_to_string(d.path().join("converge.csv")).unwrap();
+    let mut lines = csv.lines();
+    assert_eq!(
+        lines.next(),
+        Some("config,spp,seconds,rmse,relmse,ssim,relmse_trimmed,target_error,estimated_relmse")
+    );
+    let rows: Vec<Vec<String>> = lines
+        .map(|l| l.split(',').map(str::to_string).collect())
+        .collect();
+    let adaptive: Vec<&Vec<String>> = rows.iter().filter(|r| r[0] == "adaptive").collect();
+    assert_eq!(adaptive.len(), 2, "{csv}");
+    assert!(
+        rows.iter().any(|r| r[0] == "uniform" && r[8].is_empty()),
+        "{csv}"
+    );
+    let num = |r: &Vec<String>, i: usize| r[i].parse::<f64>().unwrap();
+    for r in &adaptive {
+        assert!(num(r, 8) <= num(r, 7), "estimate above its target: {csv}");
+    }
+    assert!(num(adaptive[1], 4) < num(adaptive[0], 4), "{csv}");
+    let summary = std::fs::read_to_string(d.path().join("summary.md")).unwrap();
+    assert!(
+        summary.contains("## Estimated against true error"),
+        "{summary}"
+    );
+}
