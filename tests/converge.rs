@@ -8,29 +8,30 @@ use prism::scene::Effect;
 use std::path::Path;
 use std::process::Command;
 
+/// Runs `prism converge` on the Cornell box at 32×32 with `args` into `out`, asserting
+/// success; returns the scene's path.
+fn cornell_study(args: &[&str], out: &Path) -> std::path::PathBuf {
+    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.ron");
+    let o = Command::cargo_bin("prism")
+        .unwrap()
+        .arg("converge")
+        .arg(&scene)
+        .args(["--size", "32x32", "--quiet"])
+        .args(args)
+        .arg("-o")
+        .arg(out)
+        .output()
+        .unwrap();
+    assert!(o.status.success(), "{}", String::from_utf8_lossy(&o.stderr));
+    scene
+}
+
 #[test]
 fn converge_writes_csv_plot_and_summary_with_falling_error() {
     let d = tempfile::tempdir().unwrap();
-    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.ron");
-    let out = Command::cargo_bin("prism")
-        .unwrap()
-        .args([
-            "converge",
-            scene.to_str().unwrap(),
-            "--size",
-            "32x32",
-            "--reference-spp",
-            "256",
-            "--quiet",
-        ])
-        .args(["--vary", "spp=1,4,16", "-o"])
-        .arg(d.path())
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+    let scene = cornell_study(
+        &["--reference-spp", "256", "--vary", "spp=1,4,16"],
+        d.path(),
     );
     for f in ["converge.csv", "converge.png", "converge.svg", "summary.md"] {
         assert!(d.path().join(f).is_file(), "{f}");
@@ -150,28 +151,16 @@ fn forcing_media_or_textures_on_a_scene_without_them_changes_nothing_beyond_nois
 #[test]
 fn converge_sets_the_estimate_beside_the_true_error() {
     let d = tempfile::tempdir().unwrap();
-    let scene = Path::new(env!("CARGO_MANIFEST_DIR")).join("scenes/cornell.ron");
-    let out = Command::cargo_bin("prism")
-        .unwrap()
-        .args([
-            "converge",
-            scene.to_str().unwrap(),
-            "--size",
-            "32x32",
+    cornell_study(
+        &[
             "--reference-spp",
             "1024",
             "--budget",
             "0.5",
-            "--quiet",
-        ])
-        .args(["--vary", "target_error=none,0.05,0.01", "-o"])
-        .arg(d.path())
-        .output()
-        .unwrap();
-    assert!(
-        out.status.success(),
-        "{}",
-        String::from_utf8_lossy(&out.stderr)
+            "--vary",
+            "target_error=none,0.05,0.01",
+        ],
+        d.path(),
     );
     let csv = std::fs::read_to_string(d.path().join("converge.csv")).unwrap();
     let mut lines = csv.lines();
