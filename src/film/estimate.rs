@@ -35,15 +35,14 @@ pub fn pixel_error(sum: [f64; 3], half: [f64; 3], n: u32) -> f64 {
     e / 3.0
 }
 
-/// Per-pixel estimated relMSE of a `width`-pixel-wide film with halves, each pixel with its
-/// own sample count ([`pixel_error`] of each; `width` is kept for estimators that look at a
-/// pixel's neighbours).
+/// Per-pixel estimated relMSE of a film with halves, each pixel with its own sample count
+/// ([`pixel_error`] of each).
 ///
 /// The median of `a·b` over the 3×3 neighbourhood was tried as `r²`, to keep a rare bright
 /// sample in one half from raising the pixel's own `a·b` with its variance: below 32 samples
 /// per pixel it overestimated the Cornell box's error 2.9× (the median of so few noisy
 /// products lies well below their mean), so the pixel's own `a·b` stays.
-pub fn pixel_errors(sums: &[[f64; 3]], half: &[[f64; 3]], counts: &[u32], _width: u32) -> Vec<f64> {
+pub fn pixel_errors(sums: &[[f64; 3]], half: &[[f64; 3]], counts: &[u32]) -> Vec<f64> {
     sums.iter()
         .zip(half)
         .zip(counts)

@@ -245,7 +245,7 @@ impl RenderOutput {
         if self.half.is_empty() {
             return Vec::new();
         }
-        crate::film::estimate::pixel_errors(&self.sums, &self.half, &self.counts, self.width)
+        crate::film::estimate::pixel_errors(&self.sums, &self.half, &self.counts)
     }
 
     /// Mean samples per pixel.
@@ -535,7 +535,7 @@ impl<
                     .map(|t| vec![(done, end.saturating_sub(done)); t.pixels()])
                     .collect()
             } else {
-                let errors = estimate::pixel_errors(&image.sums, &image.half, &counts, w);
+                let errors = estimate::pixel_errors(&image.sums, &image.half, &counts);
                 let near = estimate < 2.0 * target;
                 let add = estimate::allocate(
                     &errors,
@@ -584,12 +584,8 @@ impl<
                 }
             }
             total += pass_samples;
-            estimate = estimate::image_error(&estimate::pixel_errors(
-                &image.sums,
-                &image.half,
-                &counts,
-                w,
-            ));
+            estimate =
+                estimate::image_error(&estimate::pixel_errors(&image.sums, &image.half, &counts));
             self.progress.pass(&PassReport {
                 samples: total,
                 seconds: start.elapsed().as_secs_f64(),
