@@ -325,6 +325,20 @@ impl<
     }
 }
 
+/// Runs a tile kernel at `lanes`.
+#[cfg(not(test))]
+fn run_at<K: crate::simd::LaneKernel>(lanes: Lanes, k: K) -> K::Output {
+    crate::simd::dispatch(lanes, k)
+}
+
+/// The lib's unit tests never render (the integration tests do, against the real build), so
+/// their build instantiates the kernel at width 1 alone: all 48 variants, compiled a second
+/// time, would double the time of `cargo test --release`.
+#[cfg(test)]
+fn run_at<K: crate::simd::LaneKernel>(_lanes: Lanes, k: K) -> K::Output {
+    k.run::<f32>()
+}
+
 fn render_with<
     T: transport::Transport<S: transport::ChannelArray<N>>,
     const N: usize,
@@ -414,7 +428,7 @@ impl<
                 }
                 // Each width runs inside its entry point, so the lane code it inlines uses
                 // that width's instructions (width 1: the CPU's FMA).
-                crate::simd::dispatch(
+                run_at(
                     self.opts.lanes,
                     TileKernel::<T, N, MOTION, MEDIA> {
                         ctx: self.ctx,
