@@ -27,6 +27,7 @@ pub(super) fn info(a: InfoArgs) -> Result<(), CliError> {
         s.sampler,
         s.filter
     );
+    println!("estimator: {:?} (render.integrator.kind)", s.kind);
     match crate::simd::Lanes::resolve(s.simd) {
         Ok(lanes) => println!("simd: {}", integrator::describe_lanes(lanes)),
         Err(e) => println!("simd: {e}"),

@@ -4,6 +4,7 @@
 use super::CliError;
 use crate::kdtree::KdParams;
 use crate::scene::{Effect, RenderScene};
+use crate::scene_file::schema::Estimator;
 use crate::scene_file::{self, LoadedScene};
 use crate::systems;
 use std::path::Path;
@@ -27,6 +28,18 @@ pub(super) fn prepare(
 ) -> Result<RenderScene, CliError> {
     let mut rs = systems::prepare_frame(scene, &KdParams::default(), frame);
     force_effects(&mut rs, force)?;
+    if rs.settings.kind == Estimator::LightTracing {
+        if let Some(why) = crate::integrator::light_tracer::unsupported(&rs) {
+            return Err(CliError::Estimator(format!(
+                "LightTracing: {why}; render this scene with Path"
+            )));
+        }
+        if rs.settings.target_error.is_some() {
+            return Err(CliError::Estimator(
+                "LightTracing renders a fixed number of samples; a target error needs Path".into(),
+            ));
+        }
+    }
     Ok(rs)
 }
 

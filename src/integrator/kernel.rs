@@ -12,7 +12,7 @@
 //! packet is tested against (`tests/simd_widths.rs`).
 
 use super::bsdf::LaneChannels;
-use super::ctx::Ctx;
+use super::ctx::{Ctx, DIM_BOUNCE};
 use super::state::{C, M, MAX_W, Paths, U};
 use super::surface::{CLASS_BOUNDARY, CLASS_NONE};
 use super::transport::{ChannelArray, Transport};
@@ -87,7 +87,15 @@ pub fn render_tile<
         let surface = sf.hit & scatters & st.depth.lt(max_depth);
         st.alive = (st.alive & scattered_in_medium) | surface | boundary;
         if surface.any() {
-            material::scatter::<F, T, N, MOTION, MEDIA>(ctx, &mut st, &sf, surface, stats);
+            material::scatter::<F, T, N, MOTION, MEDIA, _>(
+                ctx,
+                &mut st,
+                &sf,
+                surface,
+                stats,
+                DIM_BOUNCE,
+                &mut material::Nee,
+            );
         }
         if MEDIA && boundary.any() {
             // Carry on in the same direction, in the medium beyond.

@@ -13,7 +13,7 @@ use super::transport::{ChannelArray, Transport};
 use super::{media, shadow};
 use crate::scene::light_lanes::LaneLightSample;
 use crate::scene::lights::LightSource;
-use crate::simd::{Float, Mask, UInt};
+use crate::simd::{Float, Mask, UInt, V3};
 
 /// The lanes whose BSDF has a density other than the diffuse one.
 pub(super) struct Glossy<'a, F: Float> {
@@ -25,6 +25,40 @@ pub(super) struct Glossy<'a, F: Float> {
     /// Rough dielectrics, and their BSDF.
     pub(super) dielectric: M<F>,
     pub(super) rough_dielectric: RoughDielectric<F>,
+}
+
+impl<F: Float> Glossy<'_, F> {
+    /// The BSDF value (no cosine) at `wo_l`, `wi_l` (shading frame) of the lanes whose BSDF
+    /// has a density (diffuse, albedo `sf.color`, where no glossy lane is set), and the
+    /// density of sampling `wi_l`. `mode` matters only for the rough dielectrics.
+    #[inline(always)]
+    pub(super) fn eval<const N: usize>(
+        &self,
+        sf: &Surface<F, N>,
+        wo_l: V3<F>,
+        wi_l: V3<F>,
+        mode: Mode,
+    ) -> (C<F, N>, F) {
+        let bsdf = Diffuse { albedo: sf.color };
+        let mut pdf = bsdf.pdf(wo_l, wi_l);
+        let mut f = bsdf.eval(wo_l, wi_l);
+        if self.conductor.any() {
+            let (c, m) = (sf.conductor(), self.conductor);
+            pdf = F::select(m, c.pdf(wo_l, wi_l), pdf);
+            f = select_c(m, c.eval(wo_l, wi_l), f);
+        }
+        if self.plastic.any() {
+            let (p, m) = (sf.plastic(self.coat), self.plastic);
+            pdf = F::select(m, p.pdf(wo_l, wi_l), pdf);
+            f = select_c(m, p.eval(wo_l, wi_l), f);
+        }
+        if self.dielectric.any() {
+            let (d, m) = (&self.rough_dielectric, self.dielectric);
+            pdf = F::select(m, d.pdf(wo_l, wi_l), pdf);
+            f = select_c(m, C::<F, N>::splat(d.eval(wo_l, wi_l, mode)), f);
+        }
+        (f, pdf)
+    }
 }
 
 /// Next-event estimation at the lanes `dm`, diffuse but for those in `glossy`: a light sample
@@ -79,25 +113,8 @@ pub(super) fn light_samples<
     if ok.none() {
         return;
     }
-    let bsdf = Diffuse { albedo: sf.color };
-    let mut bsdf_pdf = bsdf.pdf(wo_l, wi_l);
-    let mut f = bsdf.eval(wo_l, wi_l) * cos;
-    if glossy.conductor.any() {
-        let (c, m) = (sf.conductor(), glossy.conductor);
-        bsdf_pdf = F::select(m, c.pdf(wo_l, wi_l), bsdf_pdf);
-        f = select_c(m, c.eval(wo_l, wi_l) * cos, f);
-    }
-    if glossy.plastic.any() {
-        let (p, m) = (sf.plastic(glossy.coat), glossy.plastic);
-        bsdf_pdf = F::select(m, p.pdf(wo_l, wi_l), bsdf_pdf);
-        f = select_c(m, p.eval(wo_l, wi_l) * cos, f);
-    }
-    if glossy.dielectric.any() {
-        let (d, m) = (&glossy.rough_dielectric, glossy.dielectric);
-        bsdf_pdf = F::select(m, d.pdf(wo_l, wi_l), bsdf_pdf);
-        let fd = d.eval(wo_l, wi_l, Mode::Radiance) * cos.abs();
-        f = select_c(m, C::<F, N>::splat(fd), f);
-    }
+    let (f, bsdf_pdf) = glossy.eval(sf, wo_l, wi_l, Mode::Radiance);
+    let f = f * cos.abs();
     let pdf = ls.pdf;
     let w = F::select(ls.delta, F::one(), power_heuristic(pdf, bsdf_pdf));
     let rad = lane_radiance(ctx, st, &ls, &sources, ok);

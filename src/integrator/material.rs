@@ -3,7 +3,7 @@
 //! (diffuse, rough conductors and rough dielectrics), then Russian roulette.
 
 use super::bsdf::{BsdfSample, Dielectric, Diffuse, Frame, Mirror, Mode};
-use super::ctx::{Ctx, DIM_BOUNCE, DIMS_PER_BOUNCE};
+use super::ctx::{Ctx, DIMS_PER_BOUNCE};
 use super::light::Glossy;
 use super::microfacet::RoughDielectric;
 use super::state::{C, M, MAX_W, Paths, U, gdot, gnormalize, mask_from_bits, select_c};
@@ -16,24 +16,76 @@ use crate::components::Material;
 use crate::geometry::offset_ray_origin_lanes;
 use crate::simd::{Float, Mask, UInt, V3};
 
-/// One scattering event in every lane of `live`: light samples at the lanes whose BSDF has
-/// a density, then a BSDF sample per material class present, then Russian roulette.
+/// What a scattering event does at the lanes whose BSDF has a density, before its BSDF
+/// sample: next-event estimation on camera paths ([`Nee`]), a connection to the camera on
+/// light paths. The mode says what the path carries, and so which BSDF it samples.
+pub(super) trait Vertex<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize> {
+    /// Radiance on camera paths, importance on light paths.
+    const MODE: Mode;
+    /// The event's work at the lanes `m`, whose BSDF is diffuse but where `glossy` says
+    /// otherwise; `dim` is the event's first sample dimension.
+    #[allow(clippy::too_many_arguments)]
+    fn connect<const MOTION: bool, const MEDIA: bool>(
+        &mut self,
+        ctx: &Ctx,
+        st: &mut Paths<F, T, N>,
+        sf: &Surface<F, N>,
+        m: M<F>,
+        glossy: &Glossy<'_, F>,
+        frame: &Frame<F>,
+        dim: U<F>,
+        stats: &mut RenderStats,
+    );
+}
+
+/// Camera paths: a light sample at each event (when the scene samples lights).
+pub(super) struct Nee;
+
+impl<F: Float, T: Transport<S: ChannelArray<N>>, const N: usize> Vertex<F, T, N> for Nee {
+    const MODE: Mode = Mode::Radiance;
+    #[inline(always)]
+    fn connect<const MOTION: bool, const MEDIA: bool>(
+        &mut self,
+        ctx: &Ctx,
+        st: &mut Paths<F, T, N>,
+        sf: &Surface<F, N>,
+        m: M<F>,
+        glossy: &Glossy<'_, F>,
+        frame: &Frame<F>,
+        dim: U<F>,
+        stats: &mut RenderStats,
+    ) {
+        if ctx.nee {
+            light::light_samples::<F, T, N, MOTION, MEDIA>(
+                ctx, st, sf, m, glossy, frame, dim, stats,
+            );
+        }
+    }
+}
+
+/// One scattering event in every lane of `live`: `vertex`'s work at the lanes whose BSDF has
+/// a density, then a BSDF sample per material class present, then Russian roulette. Event k
+/// of a path takes the sample dimensions from `first + k * DIMS_PER_BOUNCE`.
 #[inline(always)]
+#[allow(clippy::too_many_arguments)]
 pub(super) fn scatter<
     F: Float,
     T: Transport<S: ChannelArray<N>>,
     const N: usize,
     const MOTION: bool,
     const MEDIA: bool,
+    V: Vertex<F, T, N>,
 >(
     ctx: &Ctx,
     st: &mut Paths<F, T, N>,
     sf: &Surface<F, N>,
     live: M<F>,
     stats: &mut RenderStats,
+    first: u32,
+    vertex: &mut V,
 ) {
-    let dim = U::<F>::splat(DIM_BOUNCE)
-        .wrapping_add(st.depth.wrapping_mul(U::<F>::splat(DIMS_PER_BOUNCE)));
+    let dim =
+        U::<F>::splat(first).wrapping_add(st.depth.wrapping_mul(U::<F>::splat(DIMS_PER_BOUNCE)));
     st.depth = U::<F>::select(live, st.depth.wrapping_add(U::<F>::splat(1)), st.depth);
     let wo = -st.d;
     let frame = sf.frame();
@@ -74,10 +126,8 @@ pub(super) fn scatter<
     let mut scattered = M::<F>::splat(false);
     // A plastic's base always has a density.
     let nee = dm | pm | glossy.conductor | glossy.dielectric;
-    if ctx.nee && nee.any() {
-        light::light_samples::<F, T, N, MOTION, MEDIA>(
-            ctx, st, sf, nee, &glossy, &frame, dim, stats,
-        );
+    if nee.any() {
+        vertex.connect::<MOTION, MEDIA>(ctx, st, sf, nee, &glossy, &frame, dim, stats);
     }
     if dm.any() {
         let (ux, uy) =
@@ -130,7 +180,7 @@ pub(super) fn scatter<
             eta,
             schlick: ctx.schlick,
         };
-        let bs = bsdf.sample::<C<F, N>>(wo_l, u, Mode::Radiance);
+        let bs = bsdf.sample::<C<F, N>>(wo_l, u, V::MODE);
         st.specular |= es;
         st.beta = select_c(es, st.beta * bs.weight, st.beta);
         let wi = frame.to_world(bs.wi);
@@ -156,7 +206,7 @@ pub(super) fn scatter<
                 .get_2d_lanes::<F>(st.pixel, st.sample, dim.wrapping_add(U::<F>::splat(4)));
         let bs = glossy
             .rough_dielectric
-            .sample::<C<F, N>>(wo_l, u, ux, uy, Mode::Radiance);
+            .sample::<C<F, N>>(wo_l, u, ux, uy, V::MODE);
         let wi = frame.to_world(bs.wi).normalize();
         // A direction on the wrong geometric side for its lobe (about a tilted shading
         // normal) is absorbed, as for rough conductors.

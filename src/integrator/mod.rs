@@ -35,6 +35,7 @@ pub mod generate;
 mod ggx_tables;
 pub mod kernel;
 mod light;
+pub mod light_tracer;
 mod material;
 mod media;
 pub mod microfacet;
@@ -48,6 +49,7 @@ pub use ctx::Ctx;
 
 use crate::film::{Film, Tile, TileFilm, TileWork, tiles};
 use crate::scene::{Effect, RenderScene};
+use crate::scene_file::schema::Estimator;
 use crate::simd::Lanes;
 use rayon::prelude::*;
 use std::marker::PhantomData;
@@ -356,6 +358,14 @@ fn render_with<
     };
     let mut ctx = Ctx::new(scene, scene.effects.has(Effect::Lens)).with_spectral(&spectral);
     ctx.monochromatic = opts.monochromatic;
+    // A scene light tracing cannot take yet is path traced (the CLI refuses it first).
+    if scene.settings.kind == Estimator::LightTracing
+        && !MEDIA
+        && light_tracer::unsupported(scene).is_none()
+    {
+        let tiles = tiles(scene.settings.width, scene.settings.height);
+        return light_tracer::render::<T, N, MOTION>(&ctx, opts, &tiles, progress);
+    }
     let pass = Passes::<T, N, MEDIA, MOTION> {
         ctx: &ctx,
         opts,

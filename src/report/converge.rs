@@ -92,6 +92,8 @@ pub const VARY_ALIASES: &[(&str, &str)] = &[
     ("sampler", "render.integrator.sampler"),
     ("newton_tolerance", "render.newton_tolerance"),
     ("equiangular", "render.integrator.equiangular"),
+    ("kind", "render.integrator.kind"),
+    ("integrator.kind", "render.integrator.kind"),
 ];
 
 /// The `--vary` keys of the target error: a ladder of targets, as `spp` is of counts.

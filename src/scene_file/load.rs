@@ -36,6 +36,8 @@ pub struct RenderSettings {
     pub equiangular: bool,
     /// The pixel filter camera samples are drawn from.
     pub filter: schema::Filter,
+    /// Paths from the camera or from the lights.
+    pub kind: schema::Estimator,
     /// The lane width the scene asks for (`--simd` overrides it).
     pub simd: crate::simd::SimdChoice,
     /// Render until the estimated relMSE is at most this (`--target-error` overrides it).
@@ -252,6 +254,7 @@ pub const OVERRIDE_KEYS: &[&str] = &[
     "render.integrator.wavelengths",
     "render.integrator.sampler",
     "render.integrator.equiangular",
+    "render.integrator.kind",
     "render.filter",
     "render.simd",
     "camera.position",
@@ -296,6 +299,7 @@ pub fn apply_override(scene: &mut schema::Scene, key: &str, value: &str) -> Resu
         "render.integrator.wavelengths" => r.integrator.wavelengths = val(key, value)?,
         "render.integrator.sampler" => r.integrator.sampler = val(key, value)?,
         "render.integrator.equiangular" => r.integrator.equiangular = val(key, value)?,
+        "render.integrator.kind" => r.integrator.kind = val(key, value)?,
         "render.filter" => r.filter = val(key, value)?,
         // `auto` as the CLI spells it, or a width.
         "render.simd" => {
@@ -397,6 +401,7 @@ fn build_world(
         sampler: r.integrator.sampler,
         equiangular: r.integrator.equiangular,
         filter: r.filter,
+        kind: r.integrator.kind,
         simd: r.simd,
         target_error: r.target_error.map(|t| t.0),
     };

@@ -124,6 +124,10 @@ pub struct IntegratorSettings {
     /// (equiangular sampling, combined with free-flight sampling by MIS); default `true`.
     #[serde(default = "default_true")]
     pub equiangular: bool,
+    /// The estimator: paths from the camera (`Path`, the default) or from the lights
+    /// (`LightTracing`).
+    #[serde(default)]
+    pub kind: Estimator,
 }
 
 fn default_true() -> bool {
@@ -146,6 +150,7 @@ impl Default for IntegratorSettings {
             wavelengths: default_wavelengths(),
             sampler: SamplerChoice::default(),
             equiangular: true,
+            kind: Estimator::default(),
         }
     }
 }
@@ -160,6 +165,18 @@ pub enum LightSampling {
     Nee,
     /// Pure path tracing: emitters contribute only when a path hits them.
     Path,
+}
+
+/// Which paths carry the light to the film.
+#[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
+pub enum Estimator {
+    /// Unidirectional path tracing from the camera, with the scene's `light_sampling`.
+    #[default]
+    Path,
+    /// Light tracing: paths start on the emitters, and every vertex whose BSDF has a density
+    /// connects to the camera and splats its contribution through the pixel filter. It
+    /// cannot see a specular surface from the camera.
+    LightTracing,
 }
 
 /// The pixel filter, importance-sampled (each camera sample has weight one, nothing is

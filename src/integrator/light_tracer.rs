@@ -1,0 +1,697 @@
+//! Light tracing (particle tracing): paths start on the emitters, and every vertex whose BSDF
+//! has a density connects to the camera, splatting its contribution through the pixel filter.
+//!
+//! One light path per camera sample, keyed by (seed, pixel, sample index) like every other
+//! sample, so batches hold disjoint light paths and the image is a sample-weighted mean as
+//! the path tracer's is. Pixel `j` of an image of `spp` samples per pixel is
+//! `(1/spp) Σ β f_s |cos| f_j(p) / (r² A cos³θ)` over every connection: `A` is the film's
+//! area at distance 1, θ the angle of the connection to the camera's axis, `f_j` the pixel
+//! filter at the raster point `p` (pbrt's `We` of the pinhole and of the thin lens, whose
+//! lens density cancels). The paths carry importance: the BSDFs are sampled in importance
+//! mode (no 1/η² at refraction) and shading normals get Veach's adjoint correction (thesis
+//! §5.3).
+//!
+//! Splats land anywhere on the film, so each work item adds them in 64-bit fixed point:
+//! integer sums do not depend on their order, and the image is the same on any thread count.
+//! The paths run one at a time through the width-1 instantiation of the kernel's stages.
+
+use super::bsdf::{Frame, LaneChannels, Mode};
+use super::ctx::{Ctx, DIM_BOUNCE, DIM_TIME, DIMS_PER_BOUNCE};
+use super::light::Glossy;
+use super::material::{self, Vertex};
+use super::state::{C, M, MAX_W, Paths, U, gdot};
+use super::surface::{CLASS_NONE, Surface};
+use super::transport::{ChannelArray, Transport};
+use super::{Observer, PassReport, RenderOptions, RenderOutput, RenderStats, pass_sizes};
+use crate::components::camera::CameraFrame;
+use crate::film::{Tile, TileWork};
+use crate::geometry::{Ray, offset_ray_origin};
+use crate::scene::RenderScene;
+use crate::scene::lights::{LightKind, LightSource};
+use crate::scene::primitives::{NO_MEDIUM, PrimKind, emitted};
+use crate::simd::V3;
+use glam::{Vec2, Vec3};
+use rayon::prelude::*;
+use std::f32::consts::PI;
+use std::sync::atomic::Ordering;
+use std::time::Instant;
+
+/// Why the scene cannot be light-traced, if it cannot (yet): media and an emitting
+/// environment.
+pub fn unsupported(scene: &RenderScene) -> Option<String> {
+    if scene.effects.has(crate::scene::Effect::Media) {
+        return Some("light tracing does not handle participating media yet".into());
+    }
+    if scene.lights.lights.iter().any(|l| {
+        matches!(
+            l,
+            LightKind::Environment(_) | LightKind::EnvMap | LightKind::Sun
+        )
+    }) {
+        return Some("light tracing does not start paths on the environment yet".into());
+    }
+    None
+}
+
+/// One in fixed point: splats are summed as integers in units of 2⁻³² (a pixel's sum may
+/// reach 2³¹ before it saturates).
+const ONE: f64 = 4_294_967_296.0;
+
+/// A film of splats in fixed point, three channels per pixel.
+struct Splats {
+    width: u32,
+    height: u32,
+    sums: Vec<[i64; 3]>,
+}
+
+impl Splats {
+    fn new(width: u32, height: u32) -> Self {
+        Splats {
+            width,
+            height,
+            sums: vec![[0; 3]; width as usize * height as usize],
+        }
+    }
+
+    /// Adds `rgb` at raster point (`fx`, `fy`) to the pixels whose filter covers it.
+    fn add(&mut self, fx: f32, fy: f32, rgb: Vec3, box_filter: bool) {
+        let mut put = |x: i64, y: i64, w: f32| {
+            if x < 0 || y < 0 || x >= i64::from(self.width) || y >= i64::from(self.height) {
+                return;
+            }
+            let s = &mut self.sums[(y * i64::from(self.width) + x) as usize];
+            for (s, c) in s.iter_mut().zip(rgb.to_array()) {
+                // `as` saturates: no splat wraps a sum around.
+                *s = s.saturating_add((f64::from(c * w) * ONE).round() as i64);
+            }
+        };
+        if box_filter {
+            put(fx.floor() as i64, fy.floor() as i64, 1.0);
+            return;
+        }
+        // A tent of radius one: the two pixel centres on each axis within one pixel.
+        let (x0, y0) = ((fx - 0.5).floor(), (fy - 0.5).floor());
+        for dy in 0..2 {
+            let wy = 1.0 - (fy - (y0 + dy as f32 + 0.5)).abs();
+            for dx in 0..2 {
+                let wx = 1.0 - (fx - (x0 + dx as f32 + 0.5)).abs();
+                if wx > 0.0 && wy > 0.0 {
+                    put(x0 as i64 + dx, y0 as i64 + dy, wx * wy);
+                }
+            }
+        }
+    }
+
+    fn merge(mut self, o: Splats) -> Splats {
+        for (a, b) in self.sums.iter_mut().zip(&o.sums) {
+            for c in 0..3 {
+                a[c] = a[c].saturating_add(b[c]);
+            }
+        }
+        self
+    }
+}
+
+/// The camera as a light path sees it: where a point lands on the film, and its importance.
+struct Camera<'a> {
+    scene: &'a RenderScene,
+    width: f32,
+    height: f32,
+    lens: bool,
+    box_filter: bool,
+}
+
+/// A connection from a scene point to the camera.
+struct Connection {
+    /// The point on the lens (the pinhole without one).
+    lens: Vec3,
+    /// Unit direction from the scene point to `lens`.
+    wc: Vec3,
+    /// Raster position, in pixels.
+    fx: f32,
+    fy: f32,
+    /// 1 / (r² A cos³θ).
+    importance: f32,
+}
+
+impl Camera<'_> {
+    /// The camera's frame at `time`.
+    fn frame<const MOTION: bool>(&self, time: f32) -> CameraFrame {
+        let s = self.scene;
+        match &s.camera_path {
+            Some(path) if MOTION && s.camera_moves => path
+                .at(time, &s.base_camera)
+                .frame(s.settings.width, s.settings.height),
+            _ => s.camera,
+        }
+    }
+
+    /// Connects `p` to the camera through the lens point drawn from `u`; `None` when `p` is
+    /// behind the camera or off the film (beyond the filter's reach of every pixel).
+    fn connect<const MOTION: bool>(&self, p: Vec3, time: f32, u: (f32, f32)) -> Option<Connection> {
+        let cam = self.frame::<MOTION>(time);
+        let lens = if self.lens {
+            let c = &self.scene.camera;
+            let (px, py) = super::generate::lens_point_lanes::<f32>(u.0, u.1, c.blades);
+            let a = c.aperture_radius;
+            cam.origin + cam.right * (px * a) + cam.up * (py * a)
+        } else {
+            cam.origin
+        };
+        let d = p - lens;
+        let r2 = d.length_squared();
+        let v = d / r2.sqrt();
+        let cos = v.dot(cam.forward);
+        if !(cos > 0.0 && r2 > 0.0) {
+            return None;
+        }
+        // Where the ray from the lens point through `p` crosses the plane in focus, seen from
+        // the pinhole at distance 1 (the inverse of `generate::camera_rays`).
+        let film = if self.lens {
+            let f = self.scene.camera.focus_distance;
+            ((lens - cam.origin) + v * (f / cos)) / f
+        } else {
+            v / cos
+        };
+        let sx = film.dot(cam.right) / cam.half.x;
+        let sy = film.dot(cam.up) / cam.half.y;
+        let fx = (sx + 1.0) * 0.5 * self.width;
+        let fy = (1.0 - sy) * 0.5 * self.height;
+        let reach = if self.box_filter { 0.0 } else { 1.0 };
+        let inside =
+            fx > -reach && fx < self.width + reach && fy > -reach && fy < self.height + reach;
+        if !inside {
+            return None;
+        }
+        let area = 4.0 * cam.half.x * cam.half.y;
+        let importance = 1.0 / (r2 * area * cos * cos * cos);
+        importance.is_finite().then_some(Connection {
+            lens,
+            wc: -v,
+            fx,
+            fy,
+            importance,
+        })
+    }
+
+    /// Whether nothing lies between `p` (leaving on the side of `n`) and the lens point.
+    fn visible<const MOTION: bool>(&self, p: Vec3, n: Vec3, c: &Connection, time: f32) -> bool {
+        let n = if n.dot(c.wc) >= 0.0 { n } else { -n };
+        let o = offset_ray_origin(p, n);
+        // The lens lies on no surface: stop just short of it.
+        !self
+            .scene
+            .occluded::<MOTION>(&Ray::new(o, c.lens - o), 1.0 - 1e-4, time)
+    }
+}
+
+/// Light-path vertices: the connection to the camera, and the adjoint BSDF sample.
+struct CameraVertex<'a, 'b> {
+    camera: &'a Camera<'b>,
+    splats: &'a mut Splats,
+    dropped: u64,
+}
+
+impl CameraVertex<'_, '_> {
+    /// Splats the contribution `c` (the transport's channels) of connection `conn`.
+    fn splat<T: Transport<S: ChannelArray<N>>, const N: usize>(
+        &mut self,
+        c: &C<f32, N>,
+        lam: &T::Lanes<f32>,
+        conn: &Connection,
+    ) {
+        let mut rgb = [Vec3::ZERO; MAX_W];
+        T::ended_rgb(c, lam, 1, &mut rgb);
+        if rgb[0].is_finite() {
+            self.splats
+                .add(conn.fx, conn.fy, rgb[0], self.camera.box_filter);
+        } else {
+            self.dropped += 1;
+        }
+    }
+}
+
+impl<T: Transport<S: ChannelArray<N>>, const N: usize> Vertex<f32, T, N> for CameraVertex<'_, '_> {
+    const MODE: Mode = Mode::Importance;
+
+    #[inline(always)]
+    fn connect<const MOTION: bool, const MEDIA: bool>(
+        &mut self,
+        ctx: &Ctx,
+        st: &mut Paths<f32, T, N>,
+        sf: &Surface<f32, N>,
+        m: M<f32>,
+        glossy: &Glossy<'_, f32>,
+        frame: &Frame<f32>,
+        dim: U<f32>,
+        stats: &mut RenderStats,
+    ) {
+        if !m {
+            return;
+        }
+        let u = ctx
+            .sampler
+            .get_2d_lanes::<f32>(st.pixel, st.sample, dim + 1);
+        let p = sf.p.lane(0);
+        let Some(conn) = self.camera.connect::<MOTION>(p, st.time, u) else {
+            return;
+        };
+        let wc = V3::<f32>::splat(conn.wc);
+        let (wl_l, wc_l) = (frame.to_local(-st.d), frame.to_local(wc));
+        let side = gdot(wc, sf.nf);
+        // The path tracer's BSDF as its light samples evaluate it, with the camera as the
+        // viewer: the light's direction above both normals, the viewer above the geometric
+        // one (a rough dielectric also transmits: the viewer below both).
+        let through = glossy.dielectric && wc_l.z < 0.0 && side < 0.0;
+        if !(wl_l.z > 0.0 && (side > 0.0 || through)) {
+            return;
+        }
+        let (f, _) = if through {
+            // The far side's frame is not this one: the adjoint at (w_l, w_c) is the same
+            // value.
+            glossy.eval(sf, wl_l, wc_l, Mode::Importance)
+        } else {
+            glossy.eval(sf, wc_l, wl_l, Mode::Radiance)
+        };
+        // f_s |w_l · n_s| |w_c · n_g| / |w_l · n_g|: Veach's shading-normal form of the
+        // measurement, whose camera side is `conn.importance`.
+        let g = wl_l.z * side.abs() / gdot(-st.d, sf.nf).abs();
+        let c = st.beta * f * (g * conn.importance);
+        if c.is_zero() {
+            return;
+        }
+        stats.shadow_rays += 1;
+        if self
+            .camera
+            .visible::<MOTION>(p, sf.nf.lane(0), &conn, st.time)
+        {
+            self.splat::<T, N>(&c, &st.lam, &conn);
+        }
+    }
+}
+
+/// A point and direction drawn on an emitter, with the throughput of the path they start.
+struct Emission<S> {
+    p: Vec3,
+    /// The emitter's normal (zero at a point light).
+    n: Vec3,
+    d: Vec3,
+    /// Radiance (area) or intensity (point) along `d`, over the densities of choosing the
+    /// emitter, the point and the direction, times |cos| at an area emitter.
+    beta: S,
+    /// Area emitters: radiance in the transport's channels, over the densities of choosing
+    /// the emitter and the point (the emitter seen by the camera); zero at point lights.
+    le: S,
+    two_sided: bool,
+}
+
+/// Draws a point on an emitter chosen by power, and a direction from it: cosine-weighted
+/// about an area emitter's normal (either side of a two-sided one), uniform in a spot's cone
+/// or over the sphere of a point light.
+fn emit<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
+    ctx: &Ctx,
+    lam: &T::Lambda,
+    time: f32,
+    u_sel: f32,
+    u_pos: Vec2,
+    u_dir: Vec2,
+) -> Option<Emission<T::S>> {
+    let scene = ctx.scene;
+    let lights = &scene.lights;
+    if lights.is_empty() {
+        return None;
+    }
+    let prims = &scene.prims;
+    let (i, pmf) = lights.table.sample(u_sel);
+    match lights.lights[i] {
+        LightKind::Point(pl) => {
+            let (d, pdf) = if pl.cos_cone <= -1.0 {
+                (
+                    crate::sampling::square_to_uniform_sphere(u_dir),
+                    crate::sampling::uniform_sphere_pdf(),
+                )
+            } else {
+                // Uniform in the cone: nothing shines outside it.
+                let cos = 1.0 - u_dir.x * (1.0 - pl.cos_cone);
+                let sin = (1.0 - cos * cos).max(0.0).sqrt();
+                let phi = 2.0 * PI * u_dir.y;
+                let (a, b) = pl.direction.any_orthonormal_pair();
+                let d = a * (sin * phi.cos()) + b * (sin * phi.sin()) + pl.direction * cos;
+                (d.normalize(), 1.0 / (2.0 * PI * (1.0 - pl.cos_cone)))
+            };
+            let scale = pl.falloff(d);
+            let source = LightSource::Point {
+                light: i as u32,
+                scale,
+            };
+            let i_rgb = pl.intensity * scale;
+            let beta = T::source_radiance(ctx, &source, i_rgb, lam);
+            Some(Emission {
+                p: pl.position,
+                n: Vec3::ZERO,
+                d,
+                beta: beta * (1.0 / (pmf * pdf)),
+                le: T::S::from_array([0.0; N]),
+                two_sided: false,
+            })
+        }
+        LightKind::Area(prim) => {
+            let l = prims.local[prim as usize] as usize;
+            let motion = if MOTION { prims.motion_of(prim) } else { None };
+            // Uniform by area, in the rest pose (a rigid motion keeps areas).
+            let (p, n, area) = match prims.kind[prim as usize] {
+                PrimKind::Sphere => {
+                    let s = &prims.spheres[l];
+                    let n = crate::sampling::square_to_uniform_sphere(u_pos);
+                    (s.center + n * s.radius, n, s.area())
+                }
+                kind @ (PrimKind::Rect | PrimKind::Disk) => {
+                    let q = &prims.planars[l];
+                    let (a, b) = if kind == PrimKind::Disk {
+                        let d = crate::sampling::square_to_uniform_disk_concentric(u_pos);
+                        (d.x, d.y)
+                    } else {
+                        (2.0 * u_pos.x - 1.0, 2.0 * u_pos.y - 1.0)
+                    };
+                    (q.center + a * q.u + b * q.v, q.n, q.area())
+                }
+                PrimKind::Box | PrimKind::Revolution | PrimKind::Mesh => return None,
+            };
+            let material = prims.material[prim as usize];
+            let mut m = prims.materials[material as usize];
+            let mut tex = None;
+            if ctx.textures
+                && let Some(t) = prims.texture_of(prim)
+                && let Some(a) = t.albedo(prims.uv_at(prim, p))
+            {
+                m = m.modulated(a);
+                tex = Some(a);
+            }
+            let (p, n) = match motion {
+                Some(mo) => (mo.point_to_world(p, time), mo.vector_to_world(n, time)),
+                None => (p, n),
+            };
+            let crate::components::Material::Light { two_sided, .. } = m else {
+                return None;
+            };
+            // Cosine-weighted about the emitting side (a two-sided emitter picks its side
+            // with the first half of u).
+            let (side, ux, sides) = if !two_sided {
+                (n, u_dir.x, 1.0)
+            } else if u_dir.x < 0.5 {
+                (n, 2.0 * u_dir.x, 2.0)
+            } else {
+                (-n, 2.0 * u_dir.x - 1.0, 2.0)
+            };
+            let local = crate::sampling::square_to_cosine_hemisphere(Vec2::new(ux, u_dir.y));
+            let (a, b) = side.any_orthonormal_pair();
+            let d = (a * local.x + b * local.y + side * local.z).normalize();
+            let rgb = emitted(&m, side, d);
+            if rgb == Vec3::ZERO || local.z <= 0.0 {
+                return None;
+            }
+            let source = LightSource::Area {
+                material,
+                tex,
+                prim,
+            };
+            let le = T::source_radiance(ctx, &source, rgb, lam) * (area / pmf);
+            // L cos / (pmf · (1/area) · cos/(π · sides)).
+            Some(Emission {
+                p,
+                n,
+                d,
+                beta: le * (PI * sides),
+                le,
+                two_sided,
+            })
+        }
+        LightKind::Environment(_) | LightKind::EnvMap | LightKind::Sun => None,
+    }
+}
+
+/// The light paths of the samples `work` names of every pixel of `tile`.
+#[allow(clippy::too_many_arguments)]
+fn trace_tile<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
+    ctx: &Ctx,
+    camera: &Camera,
+    tile: &Tile,
+    work: &TileWork,
+    splats: &mut Splats,
+    stats: &mut RenderStats,
+) {
+    let scene = ctx.scene;
+    let mut vertex = CameraVertex {
+        camera,
+        splats,
+        dropped: 0,
+    };
+    let max_depth = ctx.max_depth;
+    for p in 0..tile.pixels() {
+        let (x, y) = tile.pixel(p);
+        let (first, count) = work.range(p);
+        for k in 0..count {
+            let (index, half) = work.index(first + k);
+            let pixel = (y * ctx.width + x) | half;
+            stats.samples += 1;
+            let time = if MOTION {
+                let (open, close) = scene.shutter;
+                open + (close - open) * ctx.sampler.get_1d_lanes::<f32>(pixel, index, DIM_TIME)
+            } else {
+                scene.shutter.0
+            };
+            let lam = T::wavelengths::<f32>(ctx, pixel, index);
+            // The emission takes the dimensions of event 0; the path's events follow.
+            let dim = DIM_BOUNCE;
+            let sampler = &ctx.sampler;
+            let u_sel = sampler.get_1d_lanes::<f32>(pixel, index, dim);
+            let u_pos = sampler.get_2d_lanes::<f32>(pixel, index, dim + 1);
+            let u_dir = sampler.get_2d_lanes::<f32>(pixel, index, dim + 4);
+            let Some(e) = emit::<T, N, MOTION>(
+                ctx,
+                &T::lane(&lam, 0),
+                time,
+                u_sel,
+                Vec2::new(u_pos.0, u_pos.1),
+                Vec2::new(u_dir.0, u_dir.1),
+            ) else {
+                continue;
+            };
+            let init = T::initial_beta::<f32, N>(&lam);
+            let chan = |s: T::S| super::bsdf::Chan(s.to_array());
+            // The emitter seen by the camera: a point light is not, as in the path tracer.
+            if e.n != Vec3::ZERO {
+                let u = sampler.get_2d_lanes::<f32>(pixel, index, dim + 6);
+                if let Some(conn) = camera.connect::<MOTION>(e.p, time, u) {
+                    let cos = e.n.dot(conn.wc);
+                    if e.two_sided || cos > 0.0 {
+                        let c = init * chan(e.le) * (cos.abs() * conn.importance);
+                        stats.shadow_rays += 1;
+                        if !c.is_zero() && camera.visible::<MOTION>(e.p, e.n, &conn, time) {
+                            vertex.splat::<T, N>(&c, &lam, &conn);
+                        }
+                    }
+                }
+            }
+            let beta = init * chan(e.beta);
+            let o = if e.n == Vec3::ZERO {
+                e.p
+            } else {
+                offset_ray_origin(e.p, if e.n.dot(e.d) >= 0.0 { e.n } else { -e.n })
+            };
+            // Russian roulette weighs the throughput against the path's first.
+            let first_max = beta.max_element();
+            let mut st = Paths::<f32, T, N> {
+                o: V3::splat(o),
+                d: V3::splat(e.d),
+                beta,
+                l: C::<f32, N>::splat(0.0),
+                lam,
+                eta_scale: if first_max > 0.0 {
+                    1.0 / first_max
+                } else {
+                    1.0
+                },
+                depth: 0,
+                specular: false,
+                prev_pdf: 0.0,
+                prev_p: V3::splat(e.p),
+                time,
+                pixel,
+                sample: index,
+                alive: true,
+                medium: [NO_MEDIUM; MAX_W],
+                in_medium: false,
+                segments: [0; MAX_W],
+            };
+            while st.alive && st.depth < max_depth {
+                stats.rays += 1;
+                stats.lane_slots += 1;
+                let hits = scene.intersect_packet::<f32, MOTION>(st.o, st.d, true, time);
+                let sf =
+                    super::surface::surfaces::<f32, T, N, MOTION, false>(ctx, &st, &hits, true);
+                // Emitters absorb, as in the path tracer.
+                if !sf.hit || sf.class == CLASS_NONE {
+                    break;
+                }
+                let wo = -st.d;
+                let eta_scale = st.eta_scale;
+                material::scatter::<f32, T, N, MOTION, false, _>(
+                    ctx,
+                    &mut st,
+                    &sf,
+                    true,
+                    stats,
+                    DIM_BOUNCE + DIMS_PER_BOUNCE,
+                    &mut vertex,
+                );
+                // Importance is not compressed at refraction: keep the roulette's scale.
+                st.eta_scale = eta_scale;
+                if st.alive {
+                    // Veach's correction of the adjoint BSDF for shading normals. The path
+                    // tracer's BSDF reflects only light arriving above the shading normal.
+                    let (wi, ns, ng) = (st.d, sf.nsf, sf.nf);
+                    let reflected = gdot(wi, ng) > 0.0;
+                    let num = gdot(wo, ns).abs() * gdot(wi, ng).abs();
+                    let den = gdot(wo, ng).abs() * gdot(wi, ns).abs();
+                    if den > 0.0 && !(reflected && gdot(wo, ns) <= 0.0) {
+                        st.beta = st.beta * (num / den);
+                    } else {
+                        st.alive = false;
+                    }
+                }
+            }
+        }
+    }
+    stats.dropped += vertex.dropped;
+}
+
+/// Renders `opts.spp` light paths per pixel (fewer if stopped or out of time), in passes.
+pub(super) fn render<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
+    ctx: &Ctx,
+    opts: &RenderOptions,
+    tiles: &[Tile],
+    progress: &dyn Observer,
+) -> RenderOutput {
+    let scene = ctx.scene;
+    let (w, h) = (scene.settings.width, scene.settings.height);
+    let camera = Camera {
+        scene,
+        width: w as f32,
+        height: h as f32,
+        lens: ctx.lens,
+        box_filter: ctx.box_filter,
+    };
+    let mut sums = vec![[0.0f64; 3]; w as usize * h as usize];
+    let mut stats = RenderStats::default();
+    let start = Instant::now();
+    let stopped = || opts.stop.is_some_and(|s| s.load(Ordering::Relaxed));
+    let (mut done, mut pass, mut interrupted) = (0u32, 1u32, false);
+    let mut sizes = pass_sizes(opts.spp);
+    while done < opts.spp {
+        let n = if opts.time_limit.is_some() {
+            pass.min(opts.spp - done)
+        } else {
+            sizes.next().unwrap_or(opts.spp - done)
+        };
+        let t_pass = Instant::now();
+        let work = TileWork {
+            offset: opts.sample_offset,
+            uniform: (done, n),
+            per_pixel: None,
+            split: false,
+        };
+        let result = tiles
+            .par_iter()
+            .fold(
+                || (Splats::new(w, h), RenderStats::default()),
+                |(mut splats, mut st), tile| {
+                    if !stopped() {
+                        trace_tile::<T, N, MOTION>(ctx, &camera, tile, &work, &mut splats, &mut st);
+                        progress.samples(work.total(tile.pixels()));
+                    }
+                    (splats, st)
+                },
+            )
+            .reduce_with(|(a, mut sa), (b, sb)| {
+                sa.add(&sb);
+                (a.merge(b), sa)
+            });
+        if stopped() {
+            interrupted = true;
+            break;
+        }
+        if let Some((splats, st)) = result {
+            for (s, p) in sums.iter_mut().zip(&splats.sums) {
+                for c in 0..3 {
+                    s[c] += p[c] as f64 / ONE;
+                }
+            }
+            stats.add(&st);
+        }
+        done += n;
+        progress.pass(&PassReport {
+            samples: u64::from(done) * u64::from(w) * u64::from(h),
+            seconds: start.elapsed().as_secs_f64(),
+            estimate: None,
+        });
+        if let Some(limit) = opts.time_limit {
+            let elapsed = start.elapsed().as_secs_f64();
+            let per_sample = t_pass.elapsed().as_secs_f64() / f64::from(n);
+            let next = (pass * 2).min(opts.spp - done);
+            if elapsed + per_sample * f64::from(next) > limit {
+                break;
+            }
+            pass *= 2;
+        }
+    }
+    RenderOutput {
+        width: w,
+        height: h,
+        sums,
+        spp: done,
+        counts: Vec::new(),
+        half: Vec::new(),
+        estimate: None,
+        stats,
+        seconds: start.elapsed().as_secs_f64(),
+        lanes: crate::simd::Lanes::scalar(),
+        interrupted,
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A splat a pixel or more inside the film adds its whole value, over up to four pixels
+    /// (the tent's weights sum to one); the box puts it in the pixel it lands in.
+    #[test]
+    fn splat_weights_sum_to_one() {
+        for (i, box_filter) in [false, true].into_iter().enumerate() {
+            let mut s = Splats::new(8, 6);
+            let points = [
+                (1.0, 1.0),
+                (3.3, 2.7),
+                (6.99, 4.01),
+                (4.5, 3.5),
+                (2.25, 1.75),
+            ];
+            for &(x, y) in &points {
+                s.add(x, y, Vec3::new(1.0, 2.0, 0.5), box_filter);
+            }
+            let total: i64 = s.sums.iter().map(|p| p[1]).sum();
+            let want = 2.0 * points.len() as f64 * ONE;
+            // The weights are f32: a few ulp of the value.
+            let err = (total as f64 - want).abs();
+            assert!(err <= want * 1e-6, "case {i}: {total} against {want}");
+        }
+        let mut s = Splats::new(4, 4);
+        s.add(2.5, 1.5, Vec3::ONE, false);
+        assert_eq!(
+            s.sums[4 + 2][0] as f64,
+            ONE,
+            "a pixel centre takes the whole splat"
+        );
+    }
+}
