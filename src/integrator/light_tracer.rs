@@ -22,7 +22,7 @@ use super::material::{self, Vertex};
 use super::state::{C, M, MAX_W, Paths, U, gdot};
 use super::surface::{CLASS_NONE, Surface};
 use super::transport::{ChannelArray, Transport};
-use super::{Observer, PassReport, RenderOptions, RenderOutput, RenderStats, pass_sizes};
+use super::{Observer, RenderOptions, RenderOutput, RenderStats, uniform_passes};
 use crate::components::camera::CameraFrame;
 use crate::film::{Tile, TileWork};
 use crate::geometry::{Ray, offset_ray_origin};
@@ -586,21 +586,7 @@ pub(super) fn render<T: Transport<S: ChannelArray<N>>, const N: usize, const MOT
     let mut stats = RenderStats::default();
     let start = Instant::now();
     let stopped = || opts.stop.is_some_and(|s| s.load(Ordering::Relaxed));
-    let (mut done, mut pass, mut interrupted) = (0u32, 1u32, false);
-    let mut sizes = pass_sizes(opts.spp);
-    while done < opts.spp {
-        let n = if opts.time_limit.is_some() {
-            pass.min(opts.spp - done)
-        } else {
-            sizes.next().unwrap_or(opts.spp - done)
-        };
-        let t_pass = Instant::now();
-        let work = TileWork {
-            offset: opts.sample_offset,
-            uniform: (done, n),
-            per_pixel: None,
-            split: false,
-        };
+    let (done, interrupted) = uniform_passes(opts, w, h, progress, start, |work| {
         let result = tiles
             .par_iter()
             .fold(
@@ -618,8 +604,7 @@ pub(super) fn render<T: Transport<S: ChannelArray<N>>, const N: usize, const MOT
                 (a.merge(b), sa)
             });
         if stopped() {
-            interrupted = true;
-            break;
+            return None;
         }
         if let Some((splats, st)) = result {
             for (s, p) in sums.iter_mut().zip(&splats.sums) {
@@ -629,22 +614,8 @@ pub(super) fn render<T: Transport<S: ChannelArray<N>>, const N: usize, const MOT
             }
             stats.add(&st);
         }
-        done += n;
-        progress.pass(&PassReport {
-            samples: u64::from(done) * u64::from(w) * u64::from(h),
-            seconds: start.elapsed().as_secs_f64(),
-            estimate: None,
-        });
-        if let Some(limit) = opts.time_limit {
-            let elapsed = start.elapsed().as_secs_f64();
-            let per_sample = t_pass.elapsed().as_secs_f64() / f64::from(n);
-            let next = (pass * 2).min(opts.spp - done);
-            if elapsed + per_sample * f64::from(next) > limit {
-                break;
-            }
-            pass *= 2;
-        }
-    }
+        Some(())
+    });
     RenderOutput {
         width: w,
         height: h,

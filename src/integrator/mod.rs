@@ -327,6 +327,57 @@ impl<
     }
 }
 
+/// The uniform passes of a render of `opts.spp` samples per pixel, started at `start`: `pass`
+/// renders the samples its work item names in every tile, or returns `None` when a stop came
+/// (the pass is dropped). Returns the samples per pixel done and whether a stop came.
+fn uniform_passes(
+    opts: &RenderOptions,
+    w: u32,
+    h: u32,
+    progress: &dyn Observer,
+    start: Instant,
+    mut pass: impl FnMut(TileWork<'static>) -> Option<()>,
+) -> (u32, bool) {
+    let mut done = 0u32;
+    // With a time limit, passes double in size so the limit is checked often early on and
+    // rarely later; without one, they follow `pass_sizes`.
+    let mut size = 1;
+    let mut sizes = pass_sizes(opts.spp);
+    while done < opts.spp {
+        let n = if opts.time_limit.is_some() {
+            size.min(opts.spp - done)
+        } else {
+            sizes.next().unwrap_or(opts.spp - done)
+        };
+        let t_pass = Instant::now();
+        let work = TileWork {
+            offset: opts.sample_offset,
+            uniform: (done, n),
+            per_pixel: None,
+            split: false,
+        };
+        if pass(work).is_none() {
+            return (done, true);
+        }
+        done += n;
+        progress.pass(&PassReport {
+            samples: u64::from(done) * u64::from(w) * u64::from(h),
+            seconds: start.elapsed().as_secs_f64(),
+            estimate: None,
+        });
+        if let Some(limit) = opts.time_limit {
+            let elapsed = start.elapsed().as_secs_f64();
+            let per_sample = t_pass.elapsed().as_secs_f64() / f64::from(n);
+            let next = (size * 2).min(opts.spp - done);
+            if elapsed + per_sample * f64::from(next) > limit {
+                break;
+            }
+            size *= 2;
+        }
+    }
+    (done, false)
+}
+
 /// Runs a tile kernel at `lanes`.
 #[cfg(not(test))]
 fn run_at<K: crate::simd::LaneKernel>(lanes: Lanes, k: K) -> K::Output {
@@ -488,45 +539,9 @@ impl<
         let mut image = Film::new(w, h);
         let mut stats = RenderStats::default();
         let start = Instant::now();
-        let mut done = 0u32;
-        let mut interrupted = false;
-        // With a time limit, passes double in size so the limit is checked often early on and
-        // rarely later; without one, they follow `pass_sizes`.
-        let mut pass = 1;
-        let mut sizes = pass_sizes(opts.spp);
-        while done < opts.spp {
-            let n = if opts.time_limit.is_some() {
-                pass.min(opts.spp - done)
-            } else {
-                sizes.next().unwrap_or(opts.spp - done)
-            };
-            let t_pass = Instant::now();
-            let work = TileWork {
-                offset: opts.sample_offset,
-                uniform: (done, n),
-                per_pixel: None,
-                split: false,
-            };
-            if self.run(&mut image, &mut stats, &|_| work).is_none() {
-                interrupted = true;
-                break;
-            }
-            done += n;
-            self.progress.pass(&PassReport {
-                samples: u64::from(done) * u64::from(w) * u64::from(h),
-                seconds: start.elapsed().as_secs_f64(),
-                estimate: None,
-            });
-            if let Some(limit) = opts.time_limit {
-                let elapsed = start.elapsed().as_secs_f64();
-                let per_sample = t_pass.elapsed().as_secs_f64() / n as f64;
-                let next = (pass * 2).min(opts.spp - done);
-                if elapsed + per_sample * next as f64 > limit {
-                    break;
-                }
-                pass *= 2;
-            }
-        }
+        let (done, interrupted) = uniform_passes(opts, w, h, self.progress, start, |work| {
+            self.run(&mut image, &mut stats, &|_| work)
+        });
         let mut out = self.output(image, stats, done, start);
         out.interrupted = interrupted;
         out
