@@ -11,6 +11,7 @@ use prism::integrator::microfacet::{
     ggx_albedo, ggx_albedo_lanes, ggx_average_albedo, ggx_average_albedo_lanes,
 };
 use prism::simd::{self, Float, LaneKernel, Lanes, Mask, V3};
+use rayon::prelude::*;
 
 #[path = "common/splitmix.rs"]
 mod splitmix;
@@ -391,29 +392,37 @@ fn rough_dielectric_sampling_follows_its_pdf() {
     let thetas = [0.0f32, 45.0, 85.0];
     let etas = [1.5f32, 1.0 / 1.5];
     let tests = alphas.len() * thetas.len() * etas.len();
+    let mut cases = Vec::new();
     for (k, &alpha) in alphas.iter().enumerate() {
         for (j, &theta) in thetas.iter().enumerate() {
             for (e, &eta) in etas.iter().enumerate() {
-                let b = glass(alpha, eta);
-                let wo = incident(theta);
-                // The lobe's uniform from its own stream: the χ² harness draws two.
-                let mut g = SplitMix((k * 100 + j * 10 + e) as u64);
-                let sample = |u: glam::Vec2| {
-                    let uc = g.range(0.0, 1.0) as f32;
-                    let s = b.sample::<Chan<f32, 1>>(wo, uc, u.x, u.y, Mode::Radiance);
-                    (s.pdf > 0.0).then(|| Vec3::from(s.wi))
-                };
-                let pdf = |w: Vec3| b.pdf(wo, w.into());
-                let r = Chi2::new(400_000, (k * 31 + j * 7 + e) as u64)
-                    .tests(tests)
-                    .max_depth(7)
-                    .directions([0.0, 2.0], sample, pdf);
-                if let Err(err) = r {
-                    panic!("α = {alpha}, θ = {theta}°, η = {eta}: {err}");
-                }
+                cases.push((k, j, e, alpha, theta, eta));
             }
         }
     }
+    // The pdf's quadrature dominates: the cases run on every core.
+    let failures: Vec<String> = cases
+        .par_iter()
+        .filter_map(|&(k, j, e, alpha, theta, eta)| {
+            let b = glass(alpha, eta);
+            let wo = incident(theta);
+            // The lobe's uniform from its own stream: the χ² harness draws two.
+            let mut g = SplitMix((k * 100 + j * 10 + e) as u64);
+            let sample = |u: glam::Vec2| {
+                let uc = g.range(0.0, 1.0) as f32;
+                let s = b.sample::<Chan<f32, 1>>(wo, uc, u.x, u.y, Mode::Radiance);
+                (s.pdf > 0.0).then(|| Vec3::from(s.wi))
+            };
+            let pdf = |w: Vec3| b.pdf(wo, w.into());
+            Chi2::new(400_000, (k * 31 + j * 7 + e) as u64)
+                .tests(tests)
+                .max_depth(7)
+                .directions([0.0, 2.0], sample, pdf)
+                .err()
+                .map(|err| format!("α = {alpha}, θ = {theta}°, η = {eta}: {err}"))
+        })
+        .collect();
+    assert!(failures.is_empty(), "{failures:#?}");
 }
 
 /// Each sample's pdf is `pdf(wo, wi)` and its weight f·|cos|/pdf; reflected weights are
@@ -560,41 +569,45 @@ fn compensated_rough_dielectric_sampling_follows_its_pdf_and_weight() {
         (1.0, 70.0, 1.0 / 1.5),
         (0.6, 45.0, 2.4),
     ];
-    for (k, &(alpha, theta, eta)) in cases.iter().enumerate() {
-        let b = compensated_glass(alpha, eta, true);
-        let wo = incident(theta);
-        let mut g = SplitMix(70 + k as u64);
-        let sample = |u: glam::Vec2| {
-            let uc = g.range(0.0, 1.0) as f32;
-            let s = b.sample::<Chan<f32, 1>>(wo, uc, u.x, u.y, Mode::Radiance);
-            (s.pdf > 0.0).then(|| Vec3::from(s.wi))
-        };
-        let pdf = |w: Vec3| b.pdf(wo, w.into());
-        if let Err(err) = Chi2::new(400_000, 80 + k as u64)
-            .tests(cases.len())
-            .max_depth(7)
-            .directions([0.0, 2.0], sample, pdf)
-        {
-            panic!("α = {alpha}, θ = {theta}°, η = {eta}: {err}");
-        }
-        let mut g = SplitMix(90 + k as u64);
-        for _ in 0..5000 {
-            let u = [0; 3].map(|_| g.range(0.0, 1.0) as f32);
-            for mode in [Mode::Radiance, Mode::Importance] {
-                let s = b.sample::<Chan<f32, 1>>(wo, u[0], u[1], u[2], mode);
-                if s.pdf == 0.0 {
-                    assert_eq!(s.weight.0[0], 0.0);
-                    continue;
-                }
-                let t = s.wi.z < 0.0;
-                assert_eq!(s.is_transmission(), t);
-                let pdf = b.pdf(wo, s.wi);
-                assert!((s.pdf - pdf).abs() <= 1e-3 * pdf, "{} vs {pdf}", s.pdf);
-                let w = b.eval(wo, s.wi, mode) * s.wi.z.abs() / pdf;
-                assert!((w - s.weight.0[0]).abs() <= 1e-3 * w.max(1e-3));
+    // The pdf's quadrature dominates: the cases run on every core.
+    cases
+        .par_iter()
+        .enumerate()
+        .for_each(|(k, &(alpha, theta, eta))| {
+            let b = compensated_glass(alpha, eta, true);
+            let wo = incident(theta);
+            let mut g = SplitMix(70 + k as u64);
+            let sample = |u: glam::Vec2| {
+                let uc = g.range(0.0, 1.0) as f32;
+                let s = b.sample::<Chan<f32, 1>>(wo, uc, u.x, u.y, Mode::Radiance);
+                (s.pdf > 0.0).then(|| Vec3::from(s.wi))
+            };
+            let pdf = |w: Vec3| b.pdf(wo, w.into());
+            if let Err(err) = Chi2::new(400_000, 80 + k as u64)
+                .tests(cases.len())
+                .max_depth(7)
+                .directions([0.0, 2.0], sample, pdf)
+            {
+                panic!("α = {alpha}, θ = {theta}°, η = {eta}: {err}");
             }
-        }
-    }
+            let mut g = SplitMix(90 + k as u64);
+            for _ in 0..5000 {
+                let u = [0; 3].map(|_| g.range(0.0, 1.0) as f32);
+                for mode in [Mode::Radiance, Mode::Importance] {
+                    let s = b.sample::<Chan<f32, 1>>(wo, u[0], u[1], u[2], mode);
+                    if s.pdf == 0.0 {
+                        assert_eq!(s.weight.0[0], 0.0);
+                        continue;
+                    }
+                    let t = s.wi.z < 0.0;
+                    assert_eq!(s.is_transmission(), t);
+                    let pdf = b.pdf(wo, s.wi);
+                    assert!((s.pdf - pdf).abs() <= 1e-3 * pdf, "{} vs {pdf}", s.pdf);
+                    let w = b.eval(wo, s.wi, mode) * s.wi.z.abs() / pdf;
+                    assert!((w - s.weight.0[0]).abs() <= 1e-3 * w.max(1e-3));
+                }
+            }
+        });
 }
 
 /// The compensation lobe keeps refraction adjoint: importance from wo to wi equals radiance
