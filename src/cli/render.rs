@@ -185,6 +185,7 @@ fn render_to_file(
         monochromatic: None,
         stop: Some(film::signals::stop_flag()),
         target_error: target,
+        strategy: None,
     };
     let total = rs.settings.width as u64 * rs.settings.height as u64 * spp as u64;
     let bar = progress::Progress::new(total, a.quiet, label, target);

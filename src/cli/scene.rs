@@ -28,16 +28,17 @@ pub(super) fn prepare(
 ) -> Result<RenderScene, CliError> {
     let mut rs = systems::prepare_frame(scene, &KdParams::default(), frame);
     force_effects(&mut rs, force)?;
-    if rs.settings.kind == Estimator::LightTracing {
+    let kind = rs.settings.kind;
+    if kind != Estimator::Path {
         if let Some(why) = crate::integrator::light_tracer::unsupported(&rs) {
             return Err(CliError::Estimator(format!(
-                "LightTracing: {why}; render this scene with Path"
+                "{kind:?}: {why}; render this scene with Path"
             )));
         }
         if rs.settings.target_error.is_some() {
-            return Err(CliError::Estimator(
-                "LightTracing renders a fixed number of samples; a target error needs Path".into(),
-            ));
+            return Err(CliError::Estimator(format!(
+                "{kind:?} renders a fixed number of samples; a target error needs Path"
+            )));
         }
     }
     Ok(rs)

@@ -36,11 +36,11 @@ use std::f32::consts::PI;
 use std::sync::atomic::Ordering;
 use std::time::Instant;
 
-/// Why the scene cannot be light-traced, if it cannot (yet): media and an emitting
-/// environment.
+/// Why the scene cannot be rendered from the lights (light tracing, BDPT), if it cannot
+/// (yet): media and an emitting environment.
 pub fn unsupported(scene: &RenderScene) -> Option<String> {
     if scene.effects.has(crate::scene::Effect::Media) {
-        return Some("light tracing does not handle participating media yet".into());
+        return Some("paths from the lights do not handle participating media yet".into());
     }
     if scene.lights.lights.iter().any(|l| {
         matches!(
@@ -48,7 +48,7 @@ pub fn unsupported(scene: &RenderScene) -> Option<String> {
             LightKind::Environment(_) | LightKind::EnvMap | LightKind::Sun
         )
     }) {
-        return Some("light tracing does not start paths on the environment yet".into());
+        return Some("paths from the lights do not start on the environment yet".into());
     }
     None
 }
@@ -58,14 +58,14 @@ pub fn unsupported(scene: &RenderScene) -> Option<String> {
 const ONE: f64 = 4_294_967_296.0;
 
 /// A film of splats in fixed point, three channels per pixel.
-struct Splats {
+pub(super) struct Splats {
     width: u32,
     height: u32,
     sums: Vec<[i64; 3]>,
 }
 
 impl Splats {
-    fn new(width: u32, height: u32) -> Self {
+    pub(super) fn new(width: u32, height: u32) -> Self {
         Splats {
             width,
             height,
@@ -73,8 +73,17 @@ impl Splats {
         }
     }
 
+    /// Adds `rgb` to pixel (`x`, `y`) alone: a camera sample's own value (its filter is
+    /// importance-sampled).
+    pub(super) fn add_pixel(&mut self, x: u32, y: u32, rgb: Vec3) {
+        let s = &mut self.sums[(y * self.width + x) as usize];
+        for (s, c) in s.iter_mut().zip(rgb.to_array()) {
+            *s = s.saturating_add((f64::from(c) * ONE).round() as i64);
+        }
+    }
+
     /// Adds `rgb` at raster point (`fx`, `fy`) to the pixels whose filter covers it.
-    fn add(&mut self, fx: f32, fy: f32, rgb: Vec3, box_filter: bool) {
+    pub(super) fn add(&mut self, fx: f32, fy: f32, rgb: Vec3, box_filter: bool) {
         let mut put = |x: i64, y: i64, w: f32| {
             if x < 0 || y < 0 || x >= i64::from(self.width) || y >= i64::from(self.height) {
                 return;
@@ -113,28 +122,51 @@ impl Splats {
 }
 
 /// The camera as a light path sees it: where a point lands on the film, and its importance.
-struct Camera<'a> {
-    scene: &'a RenderScene,
-    width: f32,
-    height: f32,
-    lens: bool,
-    box_filter: bool,
+pub(super) struct Camera<'a> {
+    pub(super) scene: &'a RenderScene,
+    pub(super) width: f32,
+    pub(super) height: f32,
+    pub(super) lens: bool,
+    pub(super) box_filter: bool,
 }
 
 /// A connection from a scene point to the camera.
-struct Connection {
+pub(super) struct Connection {
     /// The point on the lens (the pinhole without one).
-    lens: Vec3,
+    pub(super) lens: Vec3,
     /// Unit direction from the scene point to `lens`.
-    wc: Vec3,
+    pub(super) wc: Vec3,
     /// Raster position, in pixels.
-    fx: f32,
-    fy: f32,
+    pub(super) fx: f32,
+    pub(super) fy: f32,
     /// 1 / (r² A cos³θ).
-    importance: f32,
+    pub(super) importance: f32,
 }
 
-impl Camera<'_> {
+impl<'a> Camera<'a> {
+    /// The camera of a render of `ctx`'s scene.
+    pub(super) fn new(ctx: &Ctx<'a>) -> Self {
+        let s = &ctx.scene.settings;
+        Camera {
+            scene: ctx.scene,
+            width: s.width as f32,
+            height: s.height as f32,
+            lens: ctx.lens,
+            box_filter: ctx.box_filter,
+        }
+    }
+
+    /// The solid-angle density of a camera ray along unit `d` at `time`: 1 / (A cos³θ), the
+    /// film's area `A` at distance 1 (a thin lens's rays through one lens point too).
+    pub(super) fn pdf_dir<const MOTION: bool>(&self, time: f32, d: Vec3) -> f32 {
+        let cam = self.frame::<MOTION>(time);
+        let cos = d.dot(cam.forward);
+        if cos <= 0.0 {
+            return 0.0;
+        }
+        1.0 / (4.0 * cam.half.x * cam.half.y * cos * cos * cos)
+    }
+
     /// The camera's frame at `time`.
     fn frame<const MOTION: bool>(&self, time: f32) -> CameraFrame {
         let s = self.scene;
@@ -148,7 +180,12 @@ impl Camera<'_> {
 
     /// Connects `p` to the camera through the lens point drawn from `u`; `None` when `p` is
     /// behind the camera or off the film (beyond the filter's reach of every pixel).
-    fn connect<const MOTION: bool>(&self, p: Vec3, time: f32, u: (f32, f32)) -> Option<Connection> {
+    pub(super) fn connect<const MOTION: bool>(
+        &self,
+        p: Vec3,
+        time: f32,
+        u: (f32, f32),
+    ) -> Option<Connection> {
         let cam = self.frame::<MOTION>(time);
         let lens = if self.lens {
             let c = &self.scene.camera;
@@ -195,7 +232,13 @@ impl Camera<'_> {
     }
 
     /// Whether nothing lies between `p` (leaving on the side of `n`) and the lens point.
-    fn visible<const MOTION: bool>(&self, p: Vec3, n: Vec3, c: &Connection, time: f32) -> bool {
+    pub(super) fn visible<const MOTION: bool>(
+        &self,
+        p: Vec3,
+        n: Vec3,
+        c: &Connection,
+        time: f32,
+    ) -> bool {
         let n = if n.dot(c.wc) >= 0.0 { n } else { -n };
         let o = offset_ray_origin(p, n);
         // The lens lies on no surface: stop just short of it.
@@ -214,7 +257,7 @@ struct CameraVertex<'a, 'b> {
 
 impl CameraVertex<'_, '_> {
     /// Splats the contribution `c` (the transport's channels) of connection `conn`.
-    fn splat<T: Transport<S: ChannelArray<N>>, const N: usize>(
+    pub(super) fn splat<T: Transport<S: ChannelArray<N>>, const N: usize>(
         &mut self,
         c: &C<f32, N>,
         lam: &T::Lanes<f32>,
@@ -290,25 +333,88 @@ impl<T: Transport<S: ChannelArray<N>>, const N: usize> Vertex<f32, T, N> for Cam
     }
 }
 
+/// Which emitter a light path starts on: what it emits in any direction.
+#[derive(Clone, Copy)]
+pub(super) enum Emitter {
+    /// An area light's (texture-modulated) material.
+    Area {
+        m: crate::components::Material,
+        source: LightSource,
+        /// 1 or 2 (a two-sided emitter).
+        sides: f32,
+    },
+    /// A point or spot light, light index `light`.
+    Point {
+        pl: crate::components::PointLight,
+        light: u32,
+    },
+}
+
 /// A point and direction drawn on an emitter, with the throughput of the path they start.
-struct Emission<S> {
-    p: Vec3,
+pub(super) struct Emission<S> {
+    pub(super) p: Vec3,
     /// The emitter's normal (zero at a point light).
-    n: Vec3,
-    d: Vec3,
+    pub(super) n: Vec3,
+    pub(super) d: Vec3,
     /// Radiance (area) or intensity (point) along `d`, over the densities of choosing the
     /// emitter, the point and the direction, times |cos| at an area emitter.
-    beta: S,
+    pub(super) beta: S,
     /// Area emitters: radiance in the transport's channels, over the densities of choosing
     /// the emitter and the point (the emitter seen by the camera); zero at point lights.
-    le: S,
-    two_sided: bool,
+    pub(super) le: S,
+    pub(super) two_sided: bool,
+    pub(super) emitter: Emitter,
+    /// The densities of choosing the emitter and the point (area measure; the choice alone
+    /// at a point light), and of the direction `d` (solid angle).
+    pub(super) pdf_pos: f32,
+    pub(super) pdf_dir: f32,
+}
+
+impl<S> Emission<S> {
+    /// What the emitter sends along unit `w` from the drawn point (radiance, or a point
+    /// light's intensity) in the transport's channels, and the density with which the
+    /// emission would have drawn `w`; `None` where it sends nothing.
+    pub(super) fn toward<T: Transport<S = S>>(
+        &self,
+        ctx: &Ctx,
+        lam: &T::Lambda,
+        w: Vec3,
+    ) -> Option<(S, f32)> {
+        match self.emitter {
+            Emitter::Area { m, source, sides } => {
+                let rgb = emitted(&m, self.n, w);
+                if rgb == Vec3::ZERO {
+                    return None;
+                }
+                let pdf = self.n.dot(w).abs() / (PI * sides);
+                Some((T::source_radiance(ctx, &source, rgb, lam), pdf))
+            }
+            Emitter::Point { pl, light } => {
+                let scale = pl.falloff(w);
+                let pdf = if pl.cos_cone <= -1.0 {
+                    crate::sampling::uniform_sphere_pdf()
+                } else if w.dot(pl.direction) >= pl.cos_cone {
+                    1.0 / (2.0 * PI * (1.0 - pl.cos_cone))
+                } else {
+                    0.0
+                };
+                if scale <= 0.0 || pdf == 0.0 {
+                    return None;
+                }
+                let source = LightSource::Point { light, scale };
+                Some((
+                    T::source_radiance(ctx, &source, pl.intensity * scale, lam),
+                    pdf,
+                ))
+            }
+        }
+    }
 }
 
 /// Draws a point on an emitter chosen by power, and a direction from it: cosine-weighted
 /// about an area emitter's normal (either side of a two-sided one), uniform in a spot's cone
 /// or over the sphere of a point light.
-fn emit<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
+pub(super) fn emit<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
     ctx: &Ctx,
     lam: &T::Lambda,
     time: f32,
@@ -353,6 +459,12 @@ fn emit<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
                 beta: beta * (1.0 / (pmf * pdf)),
                 le: T::S::from_array([0.0; N]),
                 two_sided: false,
+                emitter: Emitter::Point {
+                    pl,
+                    light: i as u32,
+                },
+                pdf_pos: pmf,
+                pdf_dir: pdf,
             })
         }
         LightKind::Area(prim) => {
@@ -424,6 +536,9 @@ fn emit<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
                 beta: le * (PI * sides),
                 le,
                 two_sided,
+                emitter: Emitter::Area { m, source, sides },
+                pdf_pos: pmf / area,
+                pdf_dir: local.z / (PI * sides),
             })
         }
         LightKind::Environment(_) | LightKind::EnvMap | LightKind::Sun => None,
@@ -573,15 +688,23 @@ pub(super) fn render<T: Transport<S: ChannelArray<N>>, const N: usize, const MOT
     tiles: &[Tile],
     progress: &dyn Observer,
 ) -> RenderOutput {
+    let camera = Camera::new(ctx);
+    splat_passes(opts, ctx, tiles, progress, |tile, work, splats, stats| {
+        trace_tile::<T, N, MOTION>(ctx, &camera, tile, work, splats, stats)
+    })
+}
+
+/// The pass loop of the estimators that splat: `trace` renders the samples a pass names of
+/// one tile into a work item's splats; the items' fixed-point sums are added per pass.
+pub(super) fn splat_passes(
+    opts: &RenderOptions,
+    ctx: &Ctx,
+    tiles: &[Tile],
+    progress: &dyn Observer,
+    trace: impl Fn(&Tile, &TileWork, &mut Splats, &mut RenderStats) + Sync,
+) -> RenderOutput {
     let scene = ctx.scene;
     let (w, h) = (scene.settings.width, scene.settings.height);
-    let camera = Camera {
-        scene,
-        width: w as f32,
-        height: h as f32,
-        lens: ctx.lens,
-        box_filter: ctx.box_filter,
-    };
     let mut sums = vec![[0.0f64; 3]; w as usize * h as usize];
     let mut stats = RenderStats::default();
     let start = Instant::now();
@@ -593,7 +716,7 @@ pub(super) fn render<T: Transport<S: ChannelArray<N>>, const N: usize, const MOT
                 || (Splats::new(w, h), RenderStats::default()),
                 |(mut splats, mut st), tile| {
                     if !stopped() {
-                        trace_tile::<T, N, MOTION>(ctx, &camera, tile, &work, &mut splats, &mut st);
+                        trace(tile, &work, &mut splats, &mut st);
                         progress.samples(work.total(tile.pixels()));
                     }
                     (splats, st)

@@ -26,6 +26,7 @@
 //! MOTION): eight monomorphised variants, chosen once per render, so an absent effect costs no
 //! branch per ray. LENS, TEXTURES and NORMAL_MAPS are flags read once per render.
 
+pub mod bdpt;
 pub mod bsdf;
 pub mod coat;
 pub mod ctx;
@@ -106,6 +107,10 @@ pub struct RenderOptions {
     /// where the estimated error is ([`crate::film::estimate`]); `spp` becomes the most any
     /// pixel may receive. `None` renders `spp` samples in every pixel.
     pub target_error: Option<f64>,
+    /// BDPT only: add strategy (s, t) alone, unweighted, instead of every strategy weighted
+    /// by MIS (a debugging view: each strategy alone converges to the image of the paths of
+    /// `s + t - 1` edges).
+    pub strategy: Option<(u32, u32)>,
 }
 
 impl RenderOptions {
@@ -119,6 +124,7 @@ impl RenderOptions {
             monochromatic: None,
             stop: None,
             target_error: None,
+            strategy: None,
         }
     }
 }
@@ -409,13 +415,19 @@ fn render_with<
     };
     let mut ctx = Ctx::new(scene, scene.effects.has(Effect::Lens)).with_spectral(&spectral);
     ctx.monochromatic = opts.monochromatic;
-    // A scene light tracing cannot take yet is path traced (the CLI refuses it first).
-    if scene.settings.kind == Estimator::LightTracing
-        && !MEDIA
-        && light_tracer::unsupported(scene).is_none()
-    {
+    // A scene the splatting estimators cannot take yet is path traced (the CLI refuses it
+    // first).
+    let kind = scene.settings.kind;
+    if kind != Estimator::Path && !MEDIA && light_tracer::unsupported(scene).is_none() {
         let tiles = tiles(scene.settings.width, scene.settings.height);
-        return light_tracer::render::<T, N, MOTION>(&ctx, opts, &tiles, progress);
+        if kind == Estimator::LightTracing {
+            return light_tracer::render::<T, N, MOTION>(&ctx, opts, &tiles, progress);
+        }
+        let which = match opts.strategy {
+            Some((s, t)) => bdpt::Strategies::Only { s, t },
+            None => bdpt::Strategies::All,
+        };
+        return bdpt::render::<T, N, MOTION>(&ctx, opts, &tiles, progress, which);
     }
     let pass = Passes::<T, N, MEDIA, MOTION> {
         ctx: &ctx,

@@ -27,6 +27,7 @@ pub(super) const CLASS_CONDUCTOR: u32 = 5;
 pub(super) const CLASS_PLASTIC: u32 = 6;
 
 /// What the surface stage found at each lane's hit point.
+#[derive(Clone, Copy)]
 pub(super) struct Surface<F: Float, const N: usize> {
     pub(super) hit: M<F>,
     pub(super) p: V3<F>,

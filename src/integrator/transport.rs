@@ -323,6 +323,8 @@ pub trait Transport: Copy + Send + Sync + 'static {
         beta: &mut Chan<F, N>,
         m: F::Mask,
     );
+    /// The lanes whose secondary wavelengths have ended (none in RGB).
+    fn terminated<F: Float>(lam: &Self::Lanes<F>) -> F::Mask;
 
     /// An empty record of lane colours, in which each lane is set at most once.
     fn colours() -> Self::Colours;
@@ -466,6 +468,10 @@ impl Transport for Rgb {
     }
     #[inline(always)]
     fn terminate_secondary<F: Float, const N: usize>(_: &mut (), _: &mut Chan<F, N>, _: F::Mask) {}
+    #[inline(always)]
+    fn terminated<F: Float>(_: &()) -> F::Mask {
+        F::Mask::splat(false)
+    }
     #[inline(always)]
     fn colours() -> RgbColours {
         RgbColours([[0.0; MAX_W]; 3])
@@ -727,6 +733,10 @@ impl Transport for Spectral {
         for b in &mut beta.0[1..] {
             *b = F::select(changed, F::zero(), *b);
         }
+    }
+    #[inline(always)]
+    fn terminated<F: Float>(lam: &LaneWavelengths<F>) -> F::Mask {
+        lam.secondary_terminated()
     }
     #[inline(always)]
     fn colours() -> SpectralColours {

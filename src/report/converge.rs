@@ -301,6 +301,7 @@ fn timed_render_to(
             monochromatic: None,
             stop: None,
             target_error: target,
+            strategy: None,
         },
         &|_| {},
     );

@@ -19,6 +19,7 @@ fn ns_per_sample(rs: &crate::scene::RenderScene, spp: u32, runs: usize) -> f64 {
         monochromatic: None,
         stop: None,
         target_error: None,
+        strategy: None,
     };
     let mut t: Vec<f64> = (0..runs)
         .map(|_| {

@@ -3,6 +3,7 @@
 
 pub mod chi2;
 pub mod colour;
+pub mod estimators;
 pub mod furnace;
 pub mod quadrature;
 pub mod render;

@@ -124,8 +124,8 @@ pub struct IntegratorSettings {
     /// (equiangular sampling, combined with free-flight sampling by MIS); default `true`.
     #[serde(default = "default_true")]
     pub equiangular: bool,
-    /// The estimator: paths from the camera (`Path`, the default) or from the lights
-    /// (`LightTracing`).
+    /// The estimator: paths from the camera (`Path`, the default), from the lights
+    /// (`LightTracing`), or from both (`Bdpt`).
     #[serde(default)]
     pub kind: Estimator,
 }
@@ -177,6 +177,9 @@ pub enum Estimator {
     /// connects to the camera and splats its contribution through the pixel filter. It
     /// cannot see a specular surface from the camera.
     LightTracing,
+    /// Bidirectional path tracing: a camera and a light subpath per sample, joined in every
+    /// way, weighted by multiple importance sampling.
+    Bdpt,
 }
 
 /// The pixel filter, importance-sampled (each camera sample has weight one, nothing is

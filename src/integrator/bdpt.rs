@@ -1,0 +1,920 @@
+//! Bidirectional path tracing (Veach 1997, ch. 10): per camera sample, a camera subpath and a
+//! light subpath, and every way of joining them. Strategy (s, t) takes the first `s` vertices
+//! of the light subpath and the first `t` of the camera subpath:
+//!
+//! - `s = 0`: the camera subpath hits an emitter;
+//! - `s = 1`: a camera vertex connects to the light subpath's point on the emitter;
+//! - `t = 1`: a light vertex connects to the camera and splats, as light tracing does;
+//! - otherwise a camera vertex and a light vertex connect through a shadow ray.
+//!
+//! Each contribution is weighted by the power heuristic over every strategy that could have
+//! made the same path, computed from ratios of neighbouring densities (the recurrence of
+//! pbrt's BDPT): no product of densities that could underflow or overflow.
+//!
+//! Both subpaths run through the kernel's own stages at width 1: the surface stage, and the
+//! material stage with a vertex hook that keeps the BSDF for later connections. The light
+//! subpath carries importance (BSDFs sampled in importance mode, Veach's shading-normal
+//! correction), as in [`super::light_tracer`]. Both carry the camera sample's four hero
+//! wavelengths; a connection keeps the hero alone when either side's vertices dispersed.
+//! Like light tracing, the estimator splats: each work item adds its values in fixed point,
+//! so the image is the same on any thread count.
+
+use super::bsdf::{Frame, LaneChannels, Mode};
+use super::ctx::{Ctx, DIM_BOUNCE, DIMS_PER_BOUNCE};
+use super::light::Glossy;
+use super::light_tracer::{Camera, Emission, Splats};
+use super::material::{self, Vertex};
+use super::microfacet::RoughDielectric;
+use super::state::{C, M, MAX_W, Paths, U, gdot};
+use super::surface::{CLASS_NONE, Surface};
+use super::transport::{ChannelArray, Transport};
+use super::{Observer, RenderOptions, RenderOutput, RenderStats};
+use crate::film::{Tile, TileWork};
+use crate::geometry::{Ray, offset_ray_origin};
+use crate::scene::primitives::{NO_MEDIUM, PrimKind};
+use crate::simd::V3;
+use glam::{Vec2, Vec3};
+use std::f32::consts::PI;
+
+/// First sample dimension of the light subpath: its emission takes the block there, event k
+/// the block `k + 1` after it. Far from the camera subpath's events and the media's range.
+pub const DIM_LIGHT_PATH: u32 = 1 << 21;
+
+/// Which strategies a render adds (a debugging view, as pbrt's `visualize_strategies`).
+#[derive(Clone, Copy, Debug, PartialEq, Eq)]
+pub enum Strategies {
+    /// Every strategy, MIS-weighted: the estimator.
+    All,
+    /// Strategy (s, t) alone and unweighted (paths of `s + t - 1` edges).
+    Only {
+        /// Vertices from the light subpath.
+        s: u32,
+        /// Vertices from the camera subpath.
+        t: u32,
+    },
+}
+
+/// The BSDF parts the material stage builds at a vertex with a density, kept for its later
+/// connections.
+#[derive(Clone, Copy)]
+struct GlossyParts {
+    plastic: bool,
+    conductor: bool,
+    dielectric: bool,
+    rough_dielectric: RoughDielectric<f32>,
+}
+
+/// A vertex of either subpath.
+struct Vtx<T: Transport, const N: usize> {
+    p: Vec3,
+    /// The geometric normal, on the side the subpath arrived from (an area emitter's own
+    /// normal at the light subpath's start; zero at the camera and at a point light).
+    ng: Vec3,
+    /// Unit direction towards the previous vertex.
+    wo: Vec3,
+    /// The subpath's throughput on arrival, and its wavelengths.
+    beta: C<f32, N>,
+    lam: T::Lanes<f32>,
+    /// Area densities of generating this vertex from the previous one (forward) and from the
+    /// next (reverse), as the subpath's own sampling would.
+    fwd: f32,
+    rev: f32,
+    /// The BSDF sampled a delta lobe here.
+    delta: bool,
+    /// The BSDF at a vertex with a density (a surface that connects).
+    bsdf: Option<(Surface<f32, N>, GlossyParts)>,
+    /// The camera subpath's emitter hit: radiance towards the previous vertex, primitive.
+    emits: Option<(C<f32, N>, u32)>,
+    /// The first sample dimension of the event at this vertex.
+    dim: u32,
+}
+
+/// The material stage's hook on BDPT subpaths: nothing is connected during the walk; the
+/// BSDF parts of a vertex with a density are kept. `LIGHT` subpaths carry importance.
+struct Keep<const LIGHT: bool> {
+    parts: Option<GlossyParts>,
+}
+
+impl<T: Transport<S: ChannelArray<N>>, const N: usize, const LIGHT: bool> Vertex<f32, T, N>
+    for Keep<LIGHT>
+{
+    const MODE: Mode = if LIGHT {
+        Mode::Importance
+    } else {
+        Mode::Radiance
+    };
+
+    #[inline(always)]
+    fn connect<const MOTION: bool, const MEDIA: bool>(
+        &mut self,
+        _: &Ctx,
+        _: &mut Paths<f32, T, N>,
+        _: &Surface<f32, N>,
+        m: M<f32>,
+        glossy: &Glossy<'_, f32>,
+        _: &Frame<f32>,
+        _: U<f32>,
+        _: &mut RenderStats,
+    ) {
+        if m {
+            self.parts = Some(GlossyParts {
+                plastic: glossy.plastic,
+                conductor: glossy.conductor,
+                dielectric: glossy.dielectric,
+                rough_dielectric: glossy.rough_dielectric,
+            });
+        }
+    }
+}
+
+/// The BSDF of a connectible vertex, as the material stage evaluates it.
+struct Bsdf<'a, const N: usize> {
+    sf: &'a Surface<f32, N>,
+    glossy: Glossy<'a, f32>,
+    frame: Frame<f32>,
+}
+
+impl<'a, const N: usize> Bsdf<'a, N> {
+    fn new(ctx: &'a Ctx, sf: &'a Surface<f32, N>, g: &GlossyParts) -> Self {
+        Bsdf {
+            sf,
+            glossy: Glossy {
+                plastic: g.plastic,
+                coat: &ctx.scene.prims.coat,
+                conductor: g.conductor,
+                dielectric: g.dielectric,
+                rough_dielectric: g.rough_dielectric,
+            },
+            frame: sf.frame(),
+        }
+    }
+
+    fn local(&self, w: Vec3) -> V3<f32> {
+        self.frame.to_local(V3::splat(w))
+    }
+
+    /// The solid-angle density of sampling `wi` given `wo` (world directions). From the far
+    /// side of a rough dielectric (a reverse density across the interface) it is the
+    /// interface seen from there: the normal flipped and the relative IOR inverted.
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        let (wo, wi) = (self.local(wo), self.local(wi));
+        if self.glossy.dielectric && wo.z < 0.0 {
+            let mut far = self.glossy.rough_dielectric;
+            far.eta = far.eta.recip();
+            let flip = |v: V3<f32>| V3::new(v.x, v.y, -v.z);
+            return far.pdf(flip(wo), flip(wi));
+        }
+        self.glossy.eval(self.sf, wo, wi, Mode::Radiance).1
+    }
+
+    /// At a camera vertex: f |cos| towards `wi` seen from `wo`, with next-event estimation's
+    /// rules (above both normals, or through a rough dielectric), and the density of
+    /// sampling `wi`.
+    fn camera_side(&self, wo: Vec3, wi: Vec3) -> Option<(C<f32, N>, f32)> {
+        let (wo_l, wi_l) = (self.local(wo), self.local(wi));
+        let side = wi.dot(self.sf.nf.lane(0));
+        let through = self.glossy.dielectric && wi_l.z < 0.0 && side < 0.0;
+        if !((wi_l.z > 0.0 && side > 0.0) || through) {
+            return None;
+        }
+        let (f, pdf) = self.glossy.eval(self.sf, wo_l, wi_l, Mode::Radiance);
+        Some((f * wi_l.z.abs(), pdf))
+    }
+
+    /// At a light vertex reached from `wl`: the adjoint BSDF towards `wc` with Veach's
+    /// shading-normal factor, f |wl·n_s| |wc·n_g| / |wl·n_g| (light tracing's rules), and
+    /// the density of sampling `wc`.
+    fn light_side(&self, wl: Vec3, wc: Vec3) -> Option<(C<f32, N>, f32)> {
+        let (wl_l, wc_l) = (self.local(wl), self.local(wc));
+        let ng = self.sf.nf.lane(0);
+        let side = wc.dot(ng);
+        let through = self.glossy.dielectric && wc_l.z < 0.0 && side < 0.0;
+        if !(wl_l.z > 0.0 && (side > 0.0 || through)) {
+            return None;
+        }
+        let (f_imp, pdf) = self.glossy.eval(self.sf, wl_l, wc_l, Mode::Importance);
+        let f = if through {
+            f_imp
+        } else {
+            self.glossy.eval(self.sf, wc_l, wl_l, Mode::Radiance).0
+        };
+        let g = wl_l.z * side.abs() / wl.dot(ng).abs();
+        Some((f * g, pdf))
+    }
+}
+
+/// Converts a solid-angle density at `from` towards `to` into an area density at `to`.
+fn to_area(pdf: f32, from: Vec3, to: Vec3, n_to: Vec3) -> f32 {
+    let d = to - from;
+    let r2 = d.length_squared();
+    if r2 == 0.0 {
+        return 0.0;
+    }
+    let cos = if n_to == Vec3::ZERO {
+        1.0
+    } else {
+        n_to.dot(d).abs() / r2.sqrt()
+    };
+    pdf * cos / r2
+}
+
+/// Whether the segment between `a` and `b` is clear, each end offset off its surface (`na`,
+/// `nb`; zero at the lens and at a point light).
+fn unoccluded<const MOTION: bool>(ctx: &Ctx, a: Vec3, na: Vec3, b: Vec3, nb: Vec3, t: f32) -> bool {
+    let d = b - a;
+    let off = |p: Vec3, n: Vec3, towards: Vec3| {
+        if n == Vec3::ZERO {
+            p
+        } else {
+            offset_ray_origin(p, if n.dot(towards) >= 0.0 { n } else { -n })
+        }
+    };
+    let o = off(a, na, d);
+    let e = off(b, nb, -d);
+    // An end on no surface cannot occlude itself; stop just short of it.
+    let t_max = if na == Vec3::ZERO || nb == Vec3::ZERO {
+        1.0 - 1e-4
+    } else {
+        1.0
+    };
+    !ctx.scene.occluded::<MOTION>(&Ray::new(o, e - o), t_max, t)
+}
+
+/// A strategy's value in the transport's channels, and the wavelengths that carry it.
+type Value<T, const N: usize> = (C<f32, N>, <T as Transport>::Lanes<f32>);
+
+/// Updated reverse densities of the four vertices next to a connection, for its MIS weight.
+struct Rev {
+    pt: f32,
+    pt_minus: f32,
+    qs: f32,
+    qs_minus: f32,
+}
+
+/// The power heuristic's weight of strategy (s, t) over every strategy that makes the same
+/// path, by the ratio recurrence: walking away from the connection, each step multiplies the
+/// ratio of the densities with which the neighbouring strategy and this one sample a vertex.
+/// Strategies that would connect at a delta vertex (or start on a delta light's point by
+/// hitting it) are not counted.
+fn mis_weight<T: Transport, const N: usize>(
+    cam: &[Vtx<T, N>],
+    light: &[Vtx<T, N>],
+    s: usize,
+    t: usize,
+    rev: &Rev,
+    delta_light: bool,
+) -> f32 {
+    if s + t == 2 {
+        return 1.0;
+    }
+    let remap = |x: f32| if x != 0.0 { x } else { 1.0 };
+    let mut sum = 0.0f32;
+    let mut ri = 1.0f32;
+    for i in (1..t).rev() {
+        let r = if i == t - 1 {
+            rev.pt
+        } else if i + 2 == t {
+            rev.pt_minus
+        } else {
+            cam[i].rev
+        };
+        ri *= remap(r) / remap(cam[i].fwd);
+        let delta = i != t - 1 && cam[i].delta;
+        if !delta && !cam[i - 1].delta {
+            sum += ri * ri;
+        }
+    }
+    ri = 1.0;
+    for i in (0..s).rev() {
+        let r = if i == s - 1 {
+            rev.qs
+        } else if i + 2 == s {
+            rev.qs_minus
+        } else {
+            light[i].rev
+        };
+        ri *= remap(r) / remap(light[i].fwd);
+        let delta = i != s - 1 && light[i].delta;
+        let before = if i > 0 {
+            light[i - 1].delta
+        } else {
+            delta_light
+        };
+        if !delta && !before {
+            sum += ri * ri;
+        }
+    }
+    1.0 / (1.0 + sum)
+}
+
+/// A subpath's walk: from the state `st` (its first ray), intersects and scatters through the
+/// kernel's stages, pushing a vertex per hit until the path ends or `path` holds `max`
+/// vertices; `pdf_dir` is the solid-angle density of the first ray. `LIGHT` subpaths carry
+/// importance.
+#[allow(clippy::too_many_arguments)]
+fn walk<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool, const LIGHT: bool>(
+    ctx: &Ctx,
+    st: &mut Paths<f32, T, N>,
+    path: &mut Vec<Vtx<T, N>>,
+    max: usize,
+    mut pdf_dir: f32,
+    first_dim: u32,
+    stats: &mut RenderStats,
+) {
+    let scene = ctx.scene;
+    while st.alive && path.len() < max {
+        stats.rays += 1;
+        stats.lane_slots += 1;
+        let hits = scene.intersect_packet::<f32, MOTION>(st.o, st.d, true, st.time);
+        let sf = super::surface::surfaces::<f32, T, N, MOTION, false>(ctx, st, &hits, true);
+        if !sf.hit {
+            break;
+        }
+        let prev = path.len() - 1;
+        let (p, ng) = (sf.p.lane(0), sf.nf.lane(0));
+        let fwd = to_area(pdf_dir, path[prev].p, p, ng);
+        let dim = first_dim + st.depth * DIMS_PER_BOUNCE;
+        let mut v = Vtx::<T, N> {
+            p,
+            ng,
+            wo: -st.d.lane(0),
+            beta: st.beta,
+            lam: st.lam,
+            fwd,
+            rev: 0.0,
+            delta: false,
+            bsdf: None,
+            emits: None,
+            dim,
+        };
+        if sf.class == CLASS_NONE {
+            // Emitters absorb. The camera subpath keeps the hit for strategy s = 0.
+            if !LIGHT && sf.emits {
+                v.emits = Some((sf.le, sf.prim[0]));
+                path.push(v);
+            }
+            break;
+        }
+        if !LIGHT && path.len() + 1 >= max {
+            // The camera subpath's last vertex only ever meets an emitter (s = 0): no BSDF.
+            path.push(v);
+            break;
+        }
+        let wo = -st.d;
+        let eta_scale = st.eta_scale;
+        let mut keep = Keep::<LIGHT> { parts: None };
+        material::scatter::<f32, T, N, MOTION, false, _>(
+            ctx, st, &sf, true, stats, first_dim, &mut keep,
+        );
+        if LIGHT {
+            // Importance is not compressed at refraction: keep the roulette's scale.
+            st.eta_scale = eta_scale;
+        }
+        // A dispersive interface ended the secondary wavelengths before its BSDF was built:
+        // connections here see the hero alone too.
+        lift_termination::<T, N>(st, &mut v);
+        v.delta = st.specular;
+        // The densities of this event: forward to the next vertex, reverse to the previous.
+        let (wi, wo_w) = (st.d.lane(0), wo.lane(0));
+        let rev = match keep.parts {
+            Some(parts) if !v.delta && st.alive => {
+                pdf_dir = st.prev_pdf;
+                Bsdf::new(ctx, &sf, &parts).pdf(wi, wo_w)
+            }
+            _ => {
+                pdf_dir = 0.0;
+                0.0
+            }
+        };
+        if LIGHT && st.alive {
+            // Veach's correction of the adjoint BSDF for shading normals, as light tracing.
+            let (wi, ns, ng) = (st.d, sf.nsf, sf.nf);
+            let reflected = gdot(wi, ng) > 0.0;
+            let num = gdot(wo, ns).abs() * gdot(wi, ng).abs();
+            let den = gdot(wo, ng).abs() * gdot(wi, ns).abs();
+            if den > 0.0 && !(reflected && gdot(wo, ns) <= 0.0) {
+                st.beta = st.beta * (num / den);
+            } else {
+                st.alive = false;
+            }
+        }
+        if let Some(parts) = keep.parts {
+            v.bsdf = Some((sf, parts));
+        }
+        path.push(v);
+        // The light subpath's last vertex still needed its BSDF, for t = 1.
+        if !st.alive || path.len() >= max {
+            break;
+        }
+        let (pp, pn) = (path[prev].p, path[prev].ng);
+        path[prev].rev = to_area(rev, p, pp, pn);
+    }
+}
+
+/// Carries a termination of the secondary wavelengths at vertex `v`'s event into `v`.
+fn lift_termination<T: Transport<S: ChannelArray<N>>, const N: usize>(
+    st: &Paths<f32, T, N>,
+    v: &mut Vtx<T, N>,
+) {
+    if T::terminated::<f32>(&st.lam) {
+        T::terminate_secondary::<f32, N>(&mut v.lam, &mut v.beta, true);
+    }
+}
+
+/// The wavelengths of a connection: the hero alone if either side's have ended.
+fn joined<T: Transport<S: ChannelArray<N>>, const N: usize>(
+    a: &T::Lanes<f32>,
+    b: &T::Lanes<f32>,
+    c: &mut C<f32, N>,
+) -> T::Lanes<f32> {
+    let mut lam = *a;
+    if T::terminated::<f32>(b) {
+        T::terminate_secondary::<f32, N>(&mut lam, c, true);
+    }
+    lam
+}
+
+/// The per-tile buffers of one worker: both subpaths, reused from sample to sample.
+struct Subpaths<T: Transport, const N: usize> {
+    cam: Vec<Vtx<T, N>>,
+    light: Vec<Vtx<T, N>>,
+}
+
+/// Renders the samples `work` names of every pixel of `tile`: per sample, both subpaths and
+/// the strategies `which` asks for, into `splats`.
+#[allow(clippy::too_many_arguments)]
+fn trace_tile<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
+    ctx: &Ctx,
+    camera: &Camera,
+    which: Strategies,
+    tile: &Tile,
+    work: &TileWork,
+    splats: &mut Splats,
+    stats: &mut RenderStats,
+) {
+    let max_depth = ctx.max_depth as usize;
+    let mut paths = Subpaths::<T, N> {
+        cam: Vec::with_capacity(max_depth + 2),
+        light: Vec::with_capacity(max_depth + 1),
+    };
+    for p in 0..tile.pixels() {
+        let (x, y) = tile.pixel(p);
+        let (first, count) = work.range(p);
+        for k in 0..count {
+            let (index, half) = work.index(first + k);
+            let pixel = (y * ctx.width + x) | half;
+            stats.samples += 1;
+            let rgb = sample::<T, N, MOTION>(
+                ctx, camera, which, &mut paths, x, y, pixel, index, splats, stats,
+            );
+            if rgb.is_finite() {
+                splats.add_pixel(x, y, rgb);
+            } else {
+                stats.dropped += 1;
+            }
+        }
+    }
+}
+
+/// A fresh width-1 path state: the ray `o`, `d` at `time`, throughput `beta`.
+#[allow(clippy::too_many_arguments)]
+fn start<T: Transport<S: ChannelArray<N>>, const N: usize>(
+    o: Vec3,
+    d: Vec3,
+    beta: C<f32, N>,
+    lam: T::Lanes<f32>,
+    eta_scale: f32,
+    time: f32,
+    pixel: u32,
+    sample: u32,
+) -> Paths<f32, T, N> {
+    Paths {
+        o: V3::splat(o),
+        d: V3::splat(d),
+        beta,
+        l: C::<f32, N>::splat(0.0),
+        lam,
+        eta_scale,
+        depth: 0,
+        specular: false,
+        prev_pdf: 0.0,
+        prev_p: V3::splat(o),
+        time,
+        pixel,
+        sample,
+        alive: true,
+        medium: [NO_MEDIUM; MAX_W],
+        in_medium: false,
+        segments: [0; MAX_W],
+    }
+}
+
+/// One camera sample: both subpaths, then every strategy. Returns the value of the sample's
+/// own pixel; light-tracing strategies (t = 1) splat where they land.
+#[allow(clippy::too_many_arguments)]
+fn sample<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
+    ctx: &Ctx,
+    camera: &Camera,
+    which: Strategies,
+    paths: &mut Subpaths<T, N>,
+    x: u32,
+    y: u32,
+    pixel: u32,
+    index: u32,
+    splats: &mut Splats,
+    stats: &mut RenderStats,
+) -> Vec3 {
+    let max_depth = ctx.max_depth as usize;
+    let sampler = &ctx.sampler;
+    // The camera subpath.
+    let ray = super::generate::camera_rays_keyed::<f32, MOTION>(ctx, x, y, pixel, index);
+    let time = ray.time;
+    let (o, d) = (ray.o.lane(0), ray.d.lane(0));
+    let lam = T::wavelengths::<f32>(ctx, pixel, index);
+    let init = T::initial_beta::<f32, N>(&lam);
+    let cam = &mut paths.cam;
+    cam.clear();
+    cam.push(Vtx {
+        p: o,
+        ng: Vec3::ZERO,
+        wo: Vec3::ZERO,
+        beta: init,
+        lam,
+        fwd: 1.0,
+        rev: 0.0,
+        delta: false,
+        bsdf: None,
+        emits: None,
+        dim: 0,
+    });
+    let mut st = start::<T, N>(o, d, init, lam, 1.0, time, pixel, index);
+    let pdf_cam = camera.pdf_dir::<MOTION>(time, d);
+    walk::<T, N, MOTION, false>(ctx, &mut st, cam, max_depth + 2, pdf_cam, DIM_BOUNCE, stats);
+    // The light subpath.
+    let light = &mut paths.light;
+    light.clear();
+    let dim = DIM_LIGHT_PATH;
+    let u_sel = sampler.get_1d_lanes::<f32>(pixel, index, dim);
+    let u_pos = sampler.get_2d_lanes::<f32>(pixel, index, dim + 1);
+    let u_dir = sampler.get_2d_lanes::<f32>(pixel, index, dim + 4);
+    let emission = super::light_tracer::emit::<T, N, MOTION>(
+        ctx,
+        &T::lane(&lam, 0),
+        time,
+        u_sel,
+        Vec2::new(u_pos.0, u_pos.1),
+        Vec2::new(u_dir.0, u_dir.1),
+    );
+    let chan = |s: T::S| super::bsdf::Chan(s.to_array());
+    if let Some(e) = &emission {
+        light.push(Vtx {
+            p: e.p,
+            ng: e.n,
+            wo: Vec3::ZERO,
+            beta: init,
+            lam,
+            fwd: e.pdf_pos,
+            rev: 0.0,
+            delta: false,
+            bsdf: None,
+            emits: None,
+            dim,
+        });
+        if max_depth >= 1 {
+            let beta = init * chan(e.beta);
+            let o = if e.n == Vec3::ZERO {
+                e.p
+            } else {
+                offset_ray_origin(e.p, if e.n.dot(e.d) >= 0.0 { e.n } else { -e.n })
+            };
+            // Russian roulette weighs the throughput against the path's first.
+            let first_max = beta.max_element();
+            let scale = if first_max > 0.0 {
+                1.0 / first_max
+            } else {
+                1.0
+            };
+            let mut st = start::<T, N>(o, e.d, beta, lam, scale, time, pixel, index);
+            st.prev_p = V3::splat(e.p);
+            walk::<T, N, MOTION, true>(
+                ctx,
+                &mut st,
+                light,
+                max_depth + 1,
+                e.pdf_dir,
+                DIM_LIGHT_PATH + DIMS_PER_BOUNCE,
+                stats,
+            );
+        }
+    }
+    let mut own = Vec3::ZERO;
+    let (cam, light) = (&paths.cam, &paths.light);
+    for t in 1..=cam.len() {
+        for s in 0..=light.len() {
+            let depth = s as i64 + t as i64 - 2;
+            if (s == 1 && t == 1) || depth < 0 || depth > max_depth as i64 {
+                continue;
+            }
+            if let Strategies::Only { s: os, t: ot } = which
+                && (os as usize != s || ot as usize != t)
+            {
+                continue;
+            }
+            let all = which == Strategies::All;
+            if t == 1 {
+                let key = (pixel, index);
+                if let Some(((c, lam), conn)) = light_to_camera::<T, N, MOTION>(
+                    ctx, camera, cam, light, s, all, key, time, stats,
+                ) {
+                    let mut rgb = [Vec3::ZERO; MAX_W];
+                    T::ended_rgb(&c, &lam, 1, &mut rgb);
+                    if rgb[0].is_finite() {
+                        splats.add(conn.0, conn.1, rgb[0], camera.box_filter);
+                    } else {
+                        stats.dropped += 1;
+                    }
+                }
+                continue;
+            }
+            let got = if s == 0 {
+                emitter_hit::<T, N>(ctx, cam, t, all)
+            } else {
+                connect::<T, N, MOTION>(ctx, cam, light, emission.as_ref(), s, t, all, time, stats)
+            };
+            if let Some((c, lam)) = got {
+                let mut rgb = [Vec3::ZERO; MAX_W];
+                T::ended_rgb(&c, &lam, 1, &mut rgb);
+                own += rgb[0];
+            }
+        }
+    }
+    own
+}
+
+/// Strategy (0, t): the camera subpath's vertex `t - 1` is an emitter.
+fn emitter_hit<T: Transport<S: ChannelArray<N>>, const N: usize>(
+    ctx: &Ctx,
+    cam: &[Vtx<T, N>],
+    t: usize,
+    weighted: bool,
+) -> Option<Value<T, N>> {
+    let pt = &cam[t - 1];
+    let (le, prim) = pt.emits?;
+    let c = pt.beta * le;
+    if c.is_zero() {
+        return None;
+    }
+    if !weighted || t == 2 {
+        return Some((c, pt.lam));
+    }
+    let scene = ctx.scene;
+    let prims = &scene.prims;
+    let l = prims.local[prim as usize] as usize;
+    let area = match prims.kind[prim as usize] {
+        PrimKind::Sphere => prims.spheres[l].area(),
+        PrimKind::Rect | PrimKind::Disk => prims.planars[l].area(),
+        // Emissive shapes no light path starts on: only this strategy finds them.
+        PrimKind::Box | PrimKind::Revolution | PrimKind::Mesh => return Some((c, pt.lam)),
+    };
+    let pmf = scene.lights.table.pmf(prims.light[prim as usize] as usize);
+    let two_sided = matches!(
+        prims.materials[prims.material[prim as usize] as usize],
+        crate::components::Material::Light {
+            two_sided: true,
+            ..
+        }
+    );
+    let sides = if two_sided { 2.0 } else { 1.0 };
+    let prev = &cam[t - 2];
+    let w = pt.wo;
+    let pdf_dir = pt.ng.dot(w).abs() / (PI * sides);
+    let rev = Rev {
+        pt: pmf / area,
+        pt_minus: to_area(pdf_dir, pt.p, prev.p, prev.ng),
+        qs: 0.0,
+        qs_minus: 0.0,
+    };
+    let w = mis_weight(cam, &[], 0, t, &rev, false);
+    Some((c * w, pt.lam))
+}
+
+/// Strategy (s, 1): light vertex `s - 1` connects to the camera (a point on the lens drawn
+/// from the event's dimensions). Returns the value, its wavelengths and the raster point.
+#[allow(clippy::too_many_arguments)]
+fn light_to_camera<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
+    ctx: &Ctx,
+    camera: &Camera,
+    cam: &[Vtx<T, N>],
+    light: &[Vtx<T, N>],
+    s: usize,
+    weighted: bool,
+    key: (u32, u32),
+    time: f32,
+    stats: &mut RenderStats,
+) -> Option<(Value<T, N>, (f32, f32))> {
+    let qs = &light[s - 1];
+    let (sf, parts) = qs.bsdf.as_ref()?;
+    let u = ctx.sampler.get_2d_lanes::<f32>(key.0, key.1, qs.dim + 1);
+    let conn = camera.connect::<MOTION>(qs.p, time, u)?;
+    let bsdf = Bsdf::new(ctx, sf, parts);
+    let (f, _) = bsdf.light_side(qs.wo, conn.wc)?;
+    let mut c = qs.beta * f * conn.importance;
+    if c.is_zero() {
+        return None;
+    }
+    stats.shadow_rays += 1;
+    if !camera.visible::<MOTION>(qs.p, qs.ng, &conn, time) {
+        return None;
+    }
+    let lam = joined::<T, N>(&qs.lam, &cam[0].lam, &mut c);
+    if weighted {
+        let prev = &light[s - 2];
+        // The camera's density towards qs is its importance (1 / (r² A cos³θ)) with qs's
+        // cosine: the pinhole's and the lens's alike.
+        let rev = Rev {
+            pt: 0.0,
+            pt_minus: 0.0,
+            qs: conn.importance * conn.wc.dot(qs.ng).abs(),
+            qs_minus: to_area(bsdf.pdf(conn.wc, qs.wo), qs.p, prev.p, prev.ng),
+        };
+        c = c * mis_weight(cam, light, s, 1, &rev, delta_light_of(light));
+    }
+    Some(((c, lam), (conn.fx, conn.fy)))
+}
+
+/// Whether the light subpath starts on a point or spot light (its start has no normal).
+fn delta_light_of<T: Transport, const N: usize>(light: &[Vtx<T, N>]) -> bool {
+    light.first().is_some_and(|v| v.ng == Vec3::ZERO)
+}
+
+/// Strategies (s ≥ 1, t ≥ 2): camera vertex `t - 1` connects to light vertex `s - 1` (the
+/// point on the emitter when s = 1) through a shadow ray.
+#[allow(clippy::too_many_arguments)]
+fn connect<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
+    ctx: &Ctx,
+    cam: &[Vtx<T, N>],
+    light: &[Vtx<T, N>],
+    emission: Option<&Emission<T::S>>,
+    s: usize,
+    t: usize,
+    weighted: bool,
+    time: f32,
+    stats: &mut RenderStats,
+) -> Option<Value<T, N>> {
+    let (pt, qs) = (&cam[t - 1], &light[s - 1]);
+    let (sf_c, parts_c) = pt.bsdf.as_ref()?;
+    let d = qs.p - pt.p;
+    let r2 = d.length_squared();
+    if r2 == 0.0 {
+        return None;
+    }
+    let w = d / r2.sqrt();
+    let bc = Bsdf::new(ctx, sf_c, parts_c);
+    let (fc, pdf_c) = bc.camera_side(pt.wo, w)?;
+    // The light side: the emitter's radiance (or intensity) at s = 1, else the adjoint BSDF.
+    let (fl, pdf_l, bl) = if s == 1 {
+        let e = emission?;
+        let (le, pdf_dir) = e.toward::<T>(ctx, &T::lane(&qs.lam, 0), -w)?;
+        let cos = if qs.ng == Vec3::ZERO {
+            1.0
+        } else {
+            qs.ng.dot(w).abs()
+        };
+        // Over the densities of the emitter and the point: `qs.fwd`.
+        let le = qs.beta * super::bsdf::Chan(le.to_array()) * (cos / qs.fwd);
+        (le, pdf_dir, None)
+    } else {
+        let (sf_l, parts_l) = qs.bsdf.as_ref()?;
+        let bl = Bsdf::new(ctx, sf_l, parts_l);
+        let (f, pdf) = bl.light_side(qs.wo, -w)?;
+        (qs.beta * f, pdf, Some(bl))
+    };
+    let mut c = pt.beta * fc * fl * (1.0 / r2);
+    if c.is_zero() {
+        return None;
+    }
+    stats.shadow_rays += 1;
+    if !unoccluded::<MOTION>(ctx, pt.p, pt.ng, qs.p, qs.ng, time) {
+        return None;
+    }
+    let lam = joined::<T, N>(&pt.lam, &qs.lam, &mut c);
+    if !weighted {
+        return Some((c, lam));
+    }
+    let cp = &cam[t - 2];
+    let rev = Rev {
+        pt: to_area(pdf_l, qs.p, pt.p, pt.ng),
+        pt_minus: to_area(bc.pdf(w, pt.wo), pt.p, cp.p, cp.ng),
+        qs: to_area(pdf_c, pt.p, qs.p, qs.ng),
+        qs_minus: match &bl {
+            Some(bl) => {
+                let lp = &light[s - 2];
+                to_area(bl.pdf(-w, qs.wo), qs.p, lp.p, lp.ng)
+            }
+            None => 0.0,
+        },
+    };
+    let weight = mis_weight(cam, light, s, t, &rev, delta_light_of(light));
+    Some((c * weight, lam))
+}
+
+/// Renders `opts.spp` samples per pixel by BDPT (fewer if stopped or out of time), in
+/// passes, adding the strategies `which` names.
+pub(super) fn render<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
+    ctx: &Ctx,
+    opts: &RenderOptions,
+    tiles: &[Tile],
+    progress: &dyn Observer,
+    which: Strategies,
+) -> RenderOutput {
+    let camera = Camera::new(ctx);
+    super::light_tracer::splat_passes(opts, ctx, tiles, progress, |tile, work, splats, stats| {
+        trace_tile::<T, N, MOTION>(ctx, &camera, which, tile, work, splats, stats)
+    })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::integrator::transport::Rgb;
+    use crate::sampling::{Sampler, SamplerKind};
+
+    /// A vertex with densities `fwd`, `rev` (nothing else matters to the weights).
+    fn vtx(fwd: f32, rev: f32, delta: bool) -> Vtx<Rgb, 3> {
+        Vtx {
+            p: Vec3::ZERO,
+            ng: Vec3::ZERO,
+            wo: Vec3::ZERO,
+            beta: C::<f32, 3>::splat(1.0),
+            lam: (),
+            fwd,
+            rev,
+            delta,
+            bsdf: None,
+            emits: None,
+            dim: 0,
+        }
+    }
+
+    /// On random paths of 1 to 8 edges, with random densities on both sides, delta vertices
+    /// and delta lights, the weights of every strategy that can make the path sum to 1.
+    #[test]
+    fn mis_weights_of_a_path_sum_to_one() {
+        let u = Sampler::new(SamplerKind::Independent, 7);
+        let mut dim = 0;
+        let mut next = || {
+            dim += 1;
+            u.get_1d(0, 0, dim)
+        };
+        for path in 0..4000 {
+            let k = 1 + (next() * 8.0) as usize;
+            // x_0 is the camera, x_k on the light. Densities of x_i sampled from the camera's
+            // side (pc) and from the light's (pl), over many orders of magnitude.
+            let delta: Vec<bool> = (0..=k).map(|i| i > 0 && i < k && next() < 0.3).collect();
+            let delta_light = next() < 0.3;
+            let mut pc: Vec<f32> = (0..=k).map(|_| (20.0 * next() - 10.0).exp()).collect();
+            let mut pl: Vec<f32> = (0..=k).map(|_| (20.0 * next() - 10.0).exp()).collect();
+            // Next to a delta vertex a subpath stores no density.
+            for i in 1..k {
+                if delta[i] {
+                    pc[i + 1] = 0.0;
+                    pl[i - 1] = 0.0;
+                }
+            }
+            let mut sum = 0.0f64;
+            let mut counted = 0;
+            for s in 0..=k {
+                let t = k + 1 - s;
+                if s == 1 && t == 1 || t == 0 {
+                    continue;
+                }
+                // The connection's ends must not be delta; a delta light is never hit.
+                if (s == 0 && delta_light) || (t >= 2 && delta[t - 1]) || (s >= 2 && delta[t]) {
+                    continue;
+                }
+                let cam: Vec<_> = (0..t).map(|i| vtx(pc[i], pl[i], delta[i])).collect();
+                let light: Vec<_> = (0..s)
+                    .map(|j| {
+                        let i = k - j;
+                        vtx(pl[i], pc[i], delta[i])
+                    })
+                    .collect();
+                let at = |v: &[f32], i: usize| v.get(i).copied().unwrap_or(0.0);
+                let rev = Rev {
+                    pt: if t >= 1 { pl[t - 1] } else { 0.0 },
+                    pt_minus: if t >= 2 { pl[t - 2] } else { 0.0 },
+                    qs: if s >= 1 { at(&pc, t) } else { 0.0 },
+                    qs_minus: if s >= 2 { at(&pc, t + 1) } else { 0.0 },
+                };
+                sum += f64::from(mis_weight(&cam, &light, s, t, &rev, delta_light));
+                counted += 1;
+            }
+            if counted > 0 {
+                assert!(
+                    (sum - 1.0).abs() < 1e-4,
+                    "path {path} of {k} edges: weights sum to {sum} over {counted} strategies"
+                );
+            }
+        }
+    }
+}
