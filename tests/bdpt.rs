@@ -240,3 +240,53 @@ fn no_nan_and_no_dropped_sample_on_shipped_scenes() {
         }
     }
 }
+
+/// `Auto` takes BDPT where a light reaches a specular or dispersive surface and BDPT can
+/// render the scene, and the path tracer elsewhere; `prism info` says which and why.
+#[test]
+fn auto_chooses_by_the_scene() {
+    use prism::integrator::bdpt::choose;
+    use prism::scene_file::schema::Estimator;
+    let pick = |name: &str, extra: &[(&str, &str)]| {
+        let mut o = vec![("render.integrator.kind", "Auto")];
+        o.extend_from_slice(extra);
+        choose(&load(name, 8, &o))
+    };
+    let (k, why) = pick("cornell.ron", &[]);
+    assert_eq!(k, Estimator::Path, "{why}");
+    assert!(why.contains("no light reaches"), "{why}");
+    let (k, why) = pick("prism.ron", &[]);
+    assert_eq!(k, Estimator::Bdpt, "{why}");
+    assert!(
+        why.contains(r#"entity "prism": dispersive Dielectric; light "lamp" reaches it"#),
+        "{why}"
+    );
+    let (k, why) = pick("caustics.ron", &[]);
+    assert_eq!(k, Estimator::Bdpt, "{why}");
+    assert!(why.contains("sphere"), "{why}");
+    let (k, why) = pick("caustics.ron", &[("render.target_error", "0.05")]);
+    assert_eq!(k, Estimator::Path, "{why}");
+    assert!(why.contains("target error"), "{why}");
+    let (k, why) = pick("diamond_bunny.ron", &[]);
+    assert_eq!(k, Estimator::Path, "{why}");
+    assert!(why.contains("environment"), "{why}");
+    let (k, why) = pick("fog_lamps.ron", &[]);
+    assert_eq!(k, Estimator::Path, "{why}");
+    assert!(why.contains("media"), "{why}");
+    let out = Command::cargo_bin("prism")
+        .unwrap()
+        .args([
+            "info",
+            "scenes/prism.ron",
+            "--set",
+            "render.integrator.kind=Auto",
+        ])
+        .output()
+        .unwrap();
+    assert!(out.status.success());
+    let text = String::from_utf8(out.stdout).unwrap();
+    assert!(
+        text.contains(r#"estimator: Bdpt (Auto: entity "prism": dispersive Dielectric"#),
+        "{text}"
+    );
+}

@@ -27,7 +27,8 @@ pub(super) fn info(a: InfoArgs) -> Result<(), CliError> {
         s.sampler,
         s.filter
     );
-    println!("estimator: {:?} (render.integrator.kind)", s.kind);
+    let (kind, why) = integrator::bdpt::choose(&rs);
+    println!("estimator: {kind:?} ({why})");
     match crate::simd::Lanes::resolve(s.simd) {
         Ok(lanes) => println!("simd: {}", integrator::describe_lanes(lanes)),
         Err(e) => println!("simd: {e}"),

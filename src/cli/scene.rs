@@ -29,7 +29,8 @@ pub(super) fn prepare(
     let mut rs = systems::prepare_frame(scene, &KdParams::default(), frame);
     force_effects(&mut rs, force)?;
     let kind = rs.settings.kind;
-    if kind != Estimator::Path {
+    // `Auto` falls back to the path tracer where BDPT cannot render the scene.
+    if kind != Estimator::Path && kind != Estimator::Auto {
         if let Some(why) = crate::integrator::light_tracer::unsupported(&rs) {
             return Err(CliError::Estimator(format!(
                 "{kind:?}: {why}; render this scene with Path"

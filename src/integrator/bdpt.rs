@@ -29,9 +29,13 @@ use super::state::{C, M, MAX_W, Paths, U, gdot};
 use super::surface::{CLASS_NONE, Surface};
 use super::transport::{ChannelArray, Transport};
 use super::{Observer, RenderOptions, RenderOutput, RenderStats};
+use crate::components::Material;
 use crate::film::{Tile, TileWork};
 use crate::geometry::{Ray, offset_ray_origin};
+use crate::scene::RenderScene;
+use crate::scene::lights::LightKind;
 use crate::scene::primitives::{NO_MEDIUM, PrimKind};
+use crate::scene_file::schema::Estimator;
 use crate::simd::V3;
 use glam::{Vec2, Vec3};
 use std::f32::consts::PI;
@@ -47,6 +51,13 @@ pub enum Strategies {
     All,
     /// Strategy (s, t) alone and unweighted (paths of `s + t - 1` edges).
     Only {
+        /// Vertices from the light subpath.
+        s: u32,
+        /// Vertices from the camera subpath.
+        t: u32,
+    },
+    /// Strategy (s, t) alone with its MIS weight: its share of the estimator's image.
+    Weighted {
         /// Vertices from the light subpath.
         s: u32,
         /// Vertices from the camera subpath.
@@ -377,7 +388,17 @@ fn walk<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool, co
         // The densities of this event: forward to the next vertex, reverse to the previous.
         let (wi, wo_w) = (st.d.lane(0), wo.lane(0));
         let rev = match keep.parts {
-            Some(parts) if !v.delta && st.alive => {
+            _ if v.delta => {
+                // A delta lobe has unit density in projected solid angle, both ways (a
+                // reflection keeps projected solid angle; refraction's η² cancels over the
+                // two interfaces a path crosses). As solid-angle densities, |cos| on each
+                // side: the specular chain's geometry then enters every strategy's density,
+                // and the ratios across it are those of the paths' true densities.
+                let ns = sf.nsf.lane(0);
+                pdf_dir = wi.dot(ns).abs();
+                wo_w.dot(ns).abs()
+            }
+            Some(parts) if st.alive => {
                 pdf_dir = st.prev_pdf;
                 Bsdf::new(ctx, &sf, &parts).pdf(wi, wo_w)
             }
@@ -615,12 +636,15 @@ fn sample<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
             if (s == 1 && t == 1) || depth < 0 || depth > max_depth as i64 {
                 continue;
             }
-            if let Strategies::Only { s: os, t: ot } = which
-                && (os as usize != s || ot as usize != t)
-            {
-                continue;
-            }
-            let all = which == Strategies::All;
+            let all = match which {
+                Strategies::All => true,
+                Strategies::Only { s: os, t: ot } | Strategies::Weighted { s: os, t: ot } => {
+                    if os as usize != s || ot as usize != t {
+                        continue;
+                    }
+                    matches!(which, Strategies::Weighted { .. })
+                }
+            };
             if t == 1 {
                 let key = (pixel, index);
                 if let Some(((c, lam), conn)) = light_to_camera::<T, N, MOTION>(
@@ -831,6 +855,97 @@ pub(super) fn render<T: Transport<S: ChannelArray<N>>, const N: usize, const MOT
     super::light_tracer::splat_passes(opts, ctx, tiles, progress, |tile, work, splats, stats| {
         trace_tile::<T, N, MOTION>(ctx, &camera, which, tile, work, splats, stats)
     })
+}
+
+/// Emission rays [`choose`] traces to find the surfaces the lights reach.
+const PROBE_RAYS: u32 = 4096;
+
+/// The estimator `render.integrator.kind` resolves to, and why: `Auto` takes BDPT where a
+/// light reaches a specular or dispersive surface (a smooth dielectric, a dispersive one of
+/// any roughness, a mirror or a smooth conductor: the first vertex of caustic paths) and
+/// BDPT can take the scene; otherwise, and for a target error, the path tracer. Which
+/// surfaces the lights reach is found by 4,096 emission rays, drawn as light paths
+/// start (lights by power). Other kinds resolve to themselves.
+pub fn choose(scene: &RenderScene) -> (Estimator, String) {
+    let kind = scene.settings.kind;
+    if kind != Estimator::Auto {
+        return (kind, "render.integrator.kind".into());
+    }
+    if let Some(why) = super::light_tracer::unsupported(scene) {
+        return (Estimator::Path, format!("Auto: {why}"));
+    }
+    if scene.settings.target_error.is_some() {
+        return (Estimator::Path, "Auto: a target error needs Path".into());
+    }
+    let prims = &scene.prims;
+    let caustic = |prim: u32| -> Option<&'static str> {
+        let smooth = |a: crate::components::Alpha| a.x.max(a.y) < super::microfacet::SMOOTH_ALPHA;
+        match prims.materials[prims.material[prim as usize] as usize] {
+            Material::Dielectric { ior, .. } if ior.is_dispersive() => {
+                Some("dispersive Dielectric")
+            }
+            Material::Dielectric { alpha, .. } if smooth(alpha) => Some("smooth Dielectric"),
+            Material::Mirror { .. } => Some("Mirror"),
+            Material::Conductor { alpha, .. } if smooth(alpha) => Some("smooth Conductor"),
+            _ => None,
+        }
+    };
+    // Hits per (specular primitive, light).
+    let mut hits: Vec<(u32, usize, u32)> = Vec::new();
+    let ctx = Ctx::new(scene, false);
+    let sampler = crate::sampling::Sampler::new(crate::sampling::SamplerKind::Independent, 1);
+    let time = scene.shutter.0;
+    for i in 0..PROBE_RAYS {
+        let u = |d: u32| sampler.get_1d(i, 0, d);
+        let u_sel = u(0);
+        let (light, _) = scene.lights.table.sample(u_sel);
+        let Some(e) = super::light_tracer::emit::<super::transport::Rgb, 3, false>(
+            &ctx,
+            &(),
+            time,
+            u_sel,
+            Vec2::new(u(1), u(2)),
+            Vec2::new(u(3), u(4)),
+        ) else {
+            continue;
+        };
+        let o = if e.n == Vec3::ZERO {
+            e.p
+        } else {
+            offset_ray_origin(e.p, if e.n.dot(e.d) >= 0.0 { e.n } else { -e.n })
+        };
+        let Some(hit) = scene.intersect::<false>(&Ray::new(o, e.d), f32::INFINITY, time) else {
+            continue;
+        };
+        if caustic(hit.prim).is_some() {
+            match hits.iter_mut().find(|h| h.0 == hit.prim && h.1 == light) {
+                Some(h) => h.2 += 1,
+                None => hits.push((hit.prim, light, 1)),
+            }
+        }
+    }
+    // The specular surface the lights reach most, and the light that reaches it most.
+    let Some(&(prim, light, _)) = hits.iter().max_by_key(|h| (h.2, std::cmp::Reverse(h.0))) else {
+        return (
+            Estimator::Path,
+            "Auto: no light reaches a specular or dispersive surface".into(),
+        );
+    };
+    let lamp = match scene.lights.lights[light] {
+        LightKind::Area(p) => format!(
+            "light {}",
+            crate::components::quoted(&prims.names[p as usize])
+        ),
+        _ => "a point light".into(),
+    };
+    (
+        Estimator::Bdpt,
+        format!(
+            "Auto: entity {}: {}; {lamp} reaches it",
+            crate::components::quoted(&prims.names[prim as usize]),
+            caustic(prim).unwrap_or_default()
+        ),
+    )
 }
 
 #[cfg(test)]

@@ -107,10 +107,10 @@ pub struct RenderOptions {
     /// where the estimated error is ([`crate::film::estimate`]); `spp` becomes the most any
     /// pixel may receive. `None` renders `spp` samples in every pixel.
     pub target_error: Option<f64>,
-    /// BDPT only: add strategy (s, t) alone, unweighted, instead of every strategy weighted
-    /// by MIS (a debugging view: each strategy alone converges to the image of the paths of
-    /// `s + t - 1` edges).
-    pub strategy: Option<(u32, u32)>,
+    /// BDPT only: which strategies to add (a debugging view: one strategy alone, unweighted,
+    /// converges to the image of the paths of its length; weighted, it shows its share of
+    /// the estimator's image). `None` adds them all, weighted.
+    pub strategy: Option<bdpt::Strategies>,
 }
 
 impl RenderOptions {
@@ -417,16 +417,13 @@ fn render_with<
     ctx.monochromatic = opts.monochromatic;
     // A scene the splatting estimators cannot take yet is path traced (the CLI refuses it
     // first).
-    let kind = scene.settings.kind;
+    let (kind, _) = bdpt::choose(scene);
     if kind != Estimator::Path && !MEDIA && light_tracer::unsupported(scene).is_none() {
         let tiles = tiles(scene.settings.width, scene.settings.height);
         if kind == Estimator::LightTracing {
             return light_tracer::render::<T, N, MOTION>(&ctx, opts, &tiles, progress);
         }
-        let which = match opts.strategy {
-            Some((s, t)) => bdpt::Strategies::Only { s, t },
-            None => bdpt::Strategies::All,
-        };
+        let which = opts.strategy.unwrap_or(bdpt::Strategies::All);
         return bdpt::render::<T, N, MOTION>(&ctx, opts, &tiles, progress, which);
     }
     let pass = Passes::<T, N, MEDIA, MOTION> {

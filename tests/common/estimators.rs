@@ -51,7 +51,7 @@ pub fn batch(rs: &RenderScene, spp: u32, b: u32) -> Image {
 pub fn batch_of(rs: &RenderScene, spp: u32, b: u32, strategy: Option<(u32, u32)>) -> Image {
     let mut o = RenderOptions::new(spp, Lanes::auto());
     o.sample_offset = b << 24;
-    o.strategy = strategy;
+    o.strategy = strategy.map(|(s, t)| prism::integrator::bdpt::Strategies::Only { s, t });
     render(rs, &o, &|_| {}).image()
 }
 

@@ -125,7 +125,7 @@ pub struct IntegratorSettings {
     #[serde(default = "default_true")]
     pub equiangular: bool,
     /// The estimator: paths from the camera (`Path`, the default), from the lights
-    /// (`LightTracing`), or from both (`Bdpt`).
+    /// (`LightTracing`), from both (`Bdpt`), or chosen by the scene (`Auto`).
     #[serde(default)]
     pub kind: Estimator,
 }
@@ -180,6 +180,9 @@ pub enum Estimator {
     /// Bidirectional path tracing: a camera and a light subpath per sample, joined in every
     /// way, weighted by multiple importance sampling.
     Bdpt,
+    /// `Bdpt` where a light reaches a specular or dispersive surface (caustic paths) and BDPT
+    /// can take the scene, else `Path` (`prism info` says which, and why).
+    Auto,
 }
 
 /// The pixel filter, importance-sampled (each camera sample has weight one, nothing is
