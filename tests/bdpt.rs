@@ -7,7 +7,7 @@
 mod common;
 
 use assert_cmd::cargo::CommandCargoExt;
-use common::estimators::{GLOSSY, LAMPS, NO_SKY, Side, agree, batch, load, side};
+use common::estimators::{GLOSSY, LAMPS, NO_SKY, Side, THIN_LENS, agree, batch, load, side};
 use prism::components::Material;
 use prism::geometry::Ray;
 use std::process::Command;
@@ -39,12 +39,7 @@ fn every_emitter_kind_in_spectral_transport() {
 /// The camera vertex lies on a hexagonal thin lens.
 #[test]
 fn thin_lens() {
-    let lens = [
-        ("camera.lens.aperture_radius", "0.15"),
-        ("camera.lens.focus_distance", "5.1"),
-        ("camera.lens.blades", "6"),
-    ];
-    against_path("thin lens", LAMPS, 32, &lens, 32, 16);
+    against_path("thin lens", LAMPS, 32, &THIN_LENS, 32, 16);
 }
 
 /// One time per pair of subpaths, moving objects within the shutter.

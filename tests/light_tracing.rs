@@ -5,7 +5,7 @@
 mod common;
 
 use assert_cmd::cargo::CommandCargoExt;
-use common::estimators::{GLOSSY, LAMPS, NO_SKY, agree, batch, load, side};
+use common::estimators::{GLOSSY, LAMPS, NO_SKY, THIN_LENS, agree, batch, load, side};
 use std::process::Command;
 
 /// The path tracer (`path_spp` per batch) and light tracing (`light_spp`) on every pixel.
@@ -35,12 +35,7 @@ fn every_emitter_kind_in_spectral_transport() {
 /// A thin lens with a hexagonal aperture, focused on the ball.
 #[test]
 fn thin_lens() {
-    let lens = [
-        ("camera.lens.aperture_radius", "0.15"),
-        ("camera.lens.focus_distance", "5.1"),
-        ("camera.lens.blades", "6"),
-    ];
-    agreement("thin lens", LAMPS, 48, &lens, 32, 32);
+    agreement("thin lens", LAMPS, 48, &THIN_LENS, 32, 32);
 }
 
 /// Moving objects within the shutter.

@@ -19,13 +19,13 @@
 //! Like light tracing, the estimator splats: each work item adds its values in fixed point,
 //! so the image is the same on any thread count.
 
-use super::bsdf::{Frame, LaneChannels, Mode};
+use super::bsdf::{Frame, Mode};
 use super::ctx::{Ctx, DIM_BOUNCE, DIMS_PER_BOUNCE};
 use super::light::Glossy;
-use super::light_tracer::{Camera, Emission, Splats};
+use super::light_tracer::{Camera, Emission, Splats, path_state};
 use super::material::{self, Vertex};
 use super::microfacet::RoughDielectric;
-use super::state::{C, M, MAX_W, Paths, U, gdot};
+use super::state::{C, M, MAX_W, Paths, U};
 use super::surface::{CLASS_NONE, Surface};
 use super::transport::{ChannelArray, Transport};
 use super::{Observer, RenderOptions, RenderOutput, RenderStats};
@@ -34,7 +34,7 @@ use crate::film::{Tile, TileWork};
 use crate::geometry::{Ray, offset_ray_origin};
 use crate::scene::RenderScene;
 use crate::scene::lights::LightKind;
-use crate::scene::primitives::{NO_MEDIUM, PrimKind};
+use crate::scene::primitives::PrimKind;
 use crate::scene_file::schema::Estimator;
 use crate::simd::V3;
 use glam::{Vec2, Vec3};
@@ -408,16 +408,7 @@ fn walk<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool, co
             }
         };
         if LIGHT && st.alive {
-            // Veach's correction of the adjoint BSDF for shading normals, as light tracing.
-            let (wi, ns, ng) = (st.d, sf.nsf, sf.nf);
-            let reflected = gdot(wi, ng) > 0.0;
-            let num = gdot(wo, ns).abs() * gdot(wi, ng).abs();
-            let den = gdot(wo, ng).abs() * gdot(wi, ns).abs();
-            if den > 0.0 && !(reflected && gdot(wo, ns) <= 0.0) {
-                st.beta = st.beta * (num / den);
-            } else {
-                st.alive = false;
-            }
+            super::light_tracer::adjoint_correction(st, wo, &sf);
         }
         if let Some(parts) = keep.parts {
             v.bsdf = Some((sf, parts));
@@ -497,39 +488,6 @@ fn trace_tile<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bo
     }
 }
 
-/// A fresh width-1 path state: the ray `o`, `d` at `time`, throughput `beta`.
-#[allow(clippy::too_many_arguments)]
-fn start<T: Transport<S: ChannelArray<N>>, const N: usize>(
-    o: Vec3,
-    d: Vec3,
-    beta: C<f32, N>,
-    lam: T::Lanes<f32>,
-    eta_scale: f32,
-    time: f32,
-    pixel: u32,
-    sample: u32,
-) -> Paths<f32, T, N> {
-    Paths {
-        o: V3::splat(o),
-        d: V3::splat(d),
-        beta,
-        l: C::<f32, N>::splat(0.0),
-        lam,
-        eta_scale,
-        depth: 0,
-        specular: false,
-        prev_pdf: 0.0,
-        prev_p: V3::splat(o),
-        time,
-        pixel,
-        sample,
-        alive: true,
-        medium: [NO_MEDIUM; MAX_W],
-        in_medium: false,
-        segments: [0; MAX_W],
-    }
-}
-
 /// One camera sample: both subpaths, then every strategy. Returns the value of the sample's
 /// own pixel; light-tracing strategies (t = 1) splat where they land.
 #[allow(clippy::too_many_arguments)]
@@ -568,7 +526,7 @@ fn sample<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
         emits: None,
         dim: 0,
     });
-    let mut st = start::<T, N>(o, d, init, lam, 1.0, time, pixel, index);
+    let mut st = path_state::<T, N>(o, d, init, lam, 1.0, time, pixel, index);
     let pdf_cam = camera.pdf_dir::<MOTION>(time, d);
     walk::<T, N, MOTION, false>(ctx, &mut st, cam, max_depth + 2, pdf_cam, DIM_BOUNCE, stats);
     // The light subpath.
@@ -602,21 +560,7 @@ fn sample<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
             dim,
         });
         if max_depth >= 1 {
-            let beta = init * chan(e.beta);
-            let o = if e.n == Vec3::ZERO {
-                e.p
-            } else {
-                offset_ray_origin(e.p, if e.n.dot(e.d) >= 0.0 { e.n } else { -e.n })
-            };
-            // Russian roulette weighs the throughput against the path's first.
-            let first_max = beta.max_element();
-            let scale = if first_max > 0.0 {
-                1.0 / first_max
-            } else {
-                1.0
-            };
-            let mut st = start::<T, N>(o, e.d, beta, lam, scale, time, pixel, index);
-            st.prev_p = V3::splat(e.p);
+            let mut st = e.path::<T, N>(init * chan(e.beta), lam, time, pixel, index);
             walk::<T, N, MOTION, true>(
                 ctx,
                 &mut st,
@@ -951,6 +895,7 @@ pub fn choose(scene: &RenderScene) -> (Estimator, String) {
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::integrator::bsdf::LaneChannels;
     use crate::integrator::transport::Rgb;
     use crate::sampling::{Sampler, SamplerKind};
 

@@ -370,6 +370,91 @@ pub(super) struct Emission<S> {
     pub(super) pdf_dir: f32,
 }
 
+impl<S: Copy> Emission<S> {
+    /// The light path leaving the drawn point along `d` with throughput `beta`: its origin
+    /// off the emitter's surface, Russian roulette weighing the throughput against this
+    /// first one.
+    pub(super) fn path<T: Transport<S = S>, const N: usize>(
+        &self,
+        beta: C<f32, N>,
+        lam: T::Lanes<f32>,
+        time: f32,
+        pixel: u32,
+        sample: u32,
+    ) -> Paths<f32, T, N>
+    where
+        S: ChannelArray<N>,
+    {
+        let n = self.n;
+        let o = if n == Vec3::ZERO {
+            self.p
+        } else {
+            offset_ray_origin(self.p, if n.dot(self.d) >= 0.0 { n } else { -n })
+        };
+        let first_max = beta.max_element();
+        let scale = if first_max > 0.0 {
+            1.0 / first_max
+        } else {
+            1.0
+        };
+        let mut st = path_state::<T, N>(o, self.d, beta, lam, scale, time, pixel, sample);
+        st.prev_p = V3::splat(self.p);
+        st
+    }
+}
+
+/// A fresh width-1 path state: the ray `o`, `d` at `time`, throughput `beta`.
+#[allow(clippy::too_many_arguments)]
+pub(super) fn path_state<T: Transport<S: ChannelArray<N>>, const N: usize>(
+    o: Vec3,
+    d: Vec3,
+    beta: C<f32, N>,
+    lam: T::Lanes<f32>,
+    eta_scale: f32,
+    time: f32,
+    pixel: u32,
+    sample: u32,
+) -> Paths<f32, T, N> {
+    Paths {
+        o: V3::splat(o),
+        d: V3::splat(d),
+        beta,
+        l: C::<f32, N>::splat(0.0),
+        lam,
+        eta_scale,
+        depth: 0,
+        specular: false,
+        prev_pdf: 0.0,
+        prev_p: V3::splat(o),
+        time,
+        pixel,
+        sample,
+        alive: true,
+        medium: [NO_MEDIUM; MAX_W],
+        in_medium: false,
+        segments: [0; MAX_W],
+    }
+}
+
+/// Veach's correction of the adjoint BSDF for shading normals (thesis §5.3), after a light
+/// path scattered at `sf` from `wo` into `st.d`. The path tracer's BSDF reflects only light
+/// arriving above the shading normal: reflected light from below it ends the path.
+pub(super) fn adjoint_correction<T: Transport, const N: usize>(
+    st: &mut Paths<f32, T, N>,
+    wo: V3<f32>,
+    sf: &Surface<f32, N>,
+) {
+    let (wi, ns, ng) = (st.d, sf.nsf, sf.nf);
+    let reflected = gdot(wi, ng) > 0.0;
+    let num = gdot(wo, ns).abs() * gdot(wi, ng).abs();
+    let den = gdot(wo, ng).abs() * gdot(wi, ns).abs();
+    if den > 0.0 && !(reflected && gdot(wo, ns) <= 0.0) {
+        st.beta = st.beta * (num / den);
+    } else {
+        st.alive = false;
+    }
+}
+
 impl<S> Emission<S> {
     /// What the emitter sends along unit `w` from the drawn point (radiance, or a point
     /// light's intensity) in the transport's channels, and the density with which the
@@ -608,37 +693,7 @@ fn trace_tile<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bo
                     }
                 }
             }
-            let beta = init * chan(e.beta);
-            let o = if e.n == Vec3::ZERO {
-                e.p
-            } else {
-                offset_ray_origin(e.p, if e.n.dot(e.d) >= 0.0 { e.n } else { -e.n })
-            };
-            // Russian roulette weighs the throughput against the path's first.
-            let first_max = beta.max_element();
-            let mut st = Paths::<f32, T, N> {
-                o: V3::splat(o),
-                d: V3::splat(e.d),
-                beta,
-                l: C::<f32, N>::splat(0.0),
-                lam,
-                eta_scale: if first_max > 0.0 {
-                    1.0 / first_max
-                } else {
-                    1.0
-                },
-                depth: 0,
-                specular: false,
-                prev_pdf: 0.0,
-                prev_p: V3::splat(e.p),
-                time,
-                pixel,
-                sample: index,
-                alive: true,
-                medium: [NO_MEDIUM; MAX_W],
-                in_medium: false,
-                segments: [0; MAX_W],
-            };
+            let mut st = e.path::<T, N>(init * chan(e.beta), lam, time, pixel, index);
             while st.alive && st.depth < max_depth {
                 stats.rays += 1;
                 stats.lane_slots += 1;
@@ -663,17 +718,7 @@ fn trace_tile<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bo
                 // Importance is not compressed at refraction: keep the roulette's scale.
                 st.eta_scale = eta_scale;
                 if st.alive {
-                    // Veach's correction of the adjoint BSDF for shading normals. The path
-                    // tracer's BSDF reflects only light arriving above the shading normal.
-                    let (wi, ns, ng) = (st.d, sf.nsf, sf.nf);
-                    let reflected = gdot(wi, ng) > 0.0;
-                    let num = gdot(wo, ns).abs() * gdot(wi, ng).abs();
-                    let den = gdot(wo, ng).abs() * gdot(wi, ns).abs();
-                    if den > 0.0 && !(reflected && gdot(wo, ns) <= 0.0) {
-                        st.beta = st.beta * (num / den);
-                    } else {
-                        st.alive = false;
-                    }
+                    adjoint_correction(&mut st, wo, &sf);
                 }
             }
         }

@@ -8,6 +8,13 @@ use prism::scene::RenderScene;
 use prism::simd::Lanes;
 use std::path::Path;
 
+/// A thin lens with a hexagonal aperture, focused on [`LAMPS`]' ball.
+pub const THIN_LENS: [(&str, &str); 3] = [
+    ("camera.lens.aperture_radius", "0.15"),
+    ("camera.lens.focus_distance", "5.1"),
+    ("camera.lens.blades", "6"),
+];
+
 /// An environment that does not emit.
 pub const NO_SKY: (&str, &str) = ("environment", "Constant(Rgb(0.0, 0.0, 0.0))");
 
