@@ -34,7 +34,6 @@ use crate::film::{Tile, TileWork};
 use crate::geometry::{Ray, offset_ray_origin};
 use crate::scene::RenderScene;
 use crate::scene::lights::LightKind;
-use crate::scene::primitives::PrimKind;
 use crate::scene_file::schema::Estimator;
 use crate::simd::V3;
 use glam::{Vec2, Vec3};
@@ -637,13 +636,11 @@ fn emitter_hit<T: Transport<S: ChannelArray<N>>, const N: usize>(
     }
     let scene = ctx.scene;
     let prims = &scene.prims;
-    let l = prims.local[prim as usize] as usize;
-    let area = match prims.kind[prim as usize] {
-        PrimKind::Sphere => prims.spheres[l].area(),
-        PrimKind::Rect | PrimKind::Disk => prims.planars[l].area(),
+    let area = crate::scene::lights::emitter_area(prims, prim);
+    if !area.is_finite() {
         // Emissive shapes no light path starts on: only this strategy finds them.
-        PrimKind::Box | PrimKind::Revolution | PrimKind::Mesh => return Some((c, pt.lam)),
-    };
+        return Some((c, pt.lam));
+    }
     let pmf = scene.lights.table.pmf(prims.light[prim as usize] as usize);
     let two_sided = matches!(
         prims.materials[prims.material[prim as usize] as usize],

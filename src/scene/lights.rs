@@ -462,9 +462,10 @@ pub fn sphere_facing_axis(
     (a.length_squared() > s.radius * s.radius && a.is_finite()).then_some(a)
 }
 
-/// World-space area of an emissive primitive (a rigid motion keeps it).
+/// World-space area of an emissive primitive (a rigid motion keeps it); infinite for the
+/// shapes lights are not sampled on.
 #[inline]
-fn emitter_area(prims: &Primitives, prim: u32) -> f32 {
+pub(crate) fn emitter_area(prims: &Primitives, prim: u32) -> f32 {
     let l = prims.local[prim as usize] as usize;
     match prims.kind[prim as usize] {
         PrimKind::Sphere => prims.spheres[l].area(),
