@@ -7,7 +7,9 @@
 mod common;
 
 use assert_cmd::cargo::CommandCargoExt;
-use common::estimators::{GLOSSY, LAMPS, NO_SKY, Side, THIN_LENS, agree, batch, load, side};
+use common::estimators::{
+    GLOSSY, GREY_SKY, LAMPS, NO_SKY, OUTDOOR, STUDIO_MAP, Side, THIN_LENS, agree, batch, load, side,
+};
 use prism::components::Material;
 use prism::geometry::Ray;
 use std::process::Command;
@@ -61,6 +63,15 @@ fn glossy_materials() {
     against_path("glossy", GLOSSY, 32, &[], 32, 16);
 }
 
+/// Light paths from the environment (a disc at infinity): the spectral sky and its sun, an
+/// importance-sampled map and a constant environment, every strategy.
+#[test]
+fn environment_lights() {
+    against_path("sky and sun", OUTDOOR, 24, &[], 32, 16);
+    against_path("environment map", OUTDOOR, 24, &[STUDIO_MAP], 32, 16);
+    against_path("constant environment", OUTDOOR, 24, &[GREY_SKY], 32, 16);
+}
+
 /// The pixels of `text` at `size`² whose filter footprint sees no delta surface (dielectric,
 /// mirror, conductor) first: there light tracing reaches every path BDPT does. Camera rays
 /// through a 5 × 5 grid over the two pixels of the tent's reach, at the shutter's opening.
@@ -95,12 +106,23 @@ fn diffuse_first(text: &str, size: u32, overrides: &[(&str, &str)]) -> Vec<bool>
 /// first: caustics, which the path tracer finds only by chance (its per-pixel error is
 /// heavy-tailed there, and its variance estimate too low).
 fn against_light(name: &str, text: &str, size: u32, light_spp: u32, bdpt_spp: u32) {
-    let o = [NO_SKY];
-    let mask = diffuse_first(text, size, &o);
+    against_light_with(name, text, size, &[NO_SKY], light_spp, bdpt_spp);
+}
+
+/// [`against_light`] with `o` as the overrides.
+fn against_light_with(
+    name: &str,
+    text: &str,
+    size: u32,
+    o: &[(&str, &str)],
+    light_spp: u32,
+    bdpt_spp: u32,
+) {
+    let mask = diffuse_first(text, size, o);
     let kept = mask.iter().filter(|&&m| m).count();
     assert!(kept * 3 >= mask.len(), "{name}: only {kept} pixels kept");
     let (a, b) = (side("LightTracing", light_spp), side("Bdpt", bdpt_spp));
-    agree(name, text, size, &o, a, b, Some(&mask));
+    agree(name, text, size, o, a, b, Some(&mask));
 }
 
 /// A small lamp's caustic through a glass ball.
@@ -133,6 +155,25 @@ const DISPERSIVE: &str = r#"Scene(
 #[test]
 fn dispersion() {
     against_light("dispersion", DISPERSIVE, 24, 32, 16);
+}
+
+/// The sun's caustic through a glass ball, and the sky seen past it.
+const SUN_CAUSTIC: &str = r#"Scene(
+    render: (width: 24, height: 24, spp: 16, max_depth: 8, seed: 1),
+    camera: (position: (0.0, 2.0, -3.0), look_at: (0.0, 0.3, 0.3), fov_y: 45.0),
+    environment: Sky(sun_elevation: 60.0, sun_azimuth: 180.0, turbidity: 3.0,
+                     ground_albedo: Rgb(0.3, 0.3, 0.3), sun: true, scale: 1.0),
+    entities: [
+        (name: "ground", shape: Rect(center: (0.0, 0.0, 0.0), u: (2.0, 0.0, 0.0), v: (0.0, 0.0, -2.0)),
+         material: Diffuse(albedo: Rgb(0.8, 0.8, 0.8))),
+        (name: "ball", shape: Sphere(center: (0.0, 0.5, 0.0), radius: 0.5),
+         material: Dielectric(ior: Constant(1.5))),
+    ],
+)"#;
+
+#[test]
+fn sun_caustic() {
+    against_light_with("sun caustic", SUN_CAUSTIC, 24, &[], 32, 16);
 }
 
 /// A floor and a wall that stops short of it, lit from above without shadows on what the
@@ -262,9 +303,6 @@ fn auto_chooses_by_the_scene() {
     let (k, why) = pick("caustics.ron", &[("render.target_error", "0.05")]);
     assert_eq!(k, Estimator::Path, "{why}");
     assert!(why.contains("target error"), "{why}");
-    let (k, why) = pick("diamond_bunny.ron", &[]);
-    assert_eq!(k, Estimator::Path, "{why}");
-    assert!(why.contains("environment"), "{why}");
     let (k, why) = pick("fog_lamps.ron", &[]);
     assert_eq!(k, Estimator::Path, "{why}");
     assert!(why.contains("media"), "{why}");

@@ -118,3 +118,25 @@ fn sphere_inside_emitting_sphere_by_path_tracing() {
     let m = enclosed(0.6, "Path");
     assert!((m / 1.2 - 1.0).abs() < 0.01, "{m}");
 }
+
+/// BDPT in the furnace: light paths start on the white environment (a disc at infinity) and
+/// every strategy is weighted against the others; the spheres still vanish.
+#[test]
+fn spheres_disappear_under_bdpt() {
+    let bdpt = ", kind: Bdpt";
+    assert_furnace("Diffuse(albedo: Rgb(1.0, 1.0, 1.0))", 1.0, bdpt);
+    assert_furnace("Mirror(tint: Rgb(1.0, 1.0, 1.0))", 1.0, bdpt);
+    assert_furnace("Dielectric(ior: Constant(1.5))", 1.0, bdpt);
+    assert_furnace("Diffuse(albedo: Rgb(0.5, 0.5, 0.5))", 0.5, bdpt);
+}
+
+/// Light tracing in the furnace: a white diffuse sphere, lit only by paths from the
+/// environment's disc, vanishes against the environment the camera sees directly.
+#[test]
+fn white_sphere_disappears_under_light_tracing() {
+    assert_furnace(
+        "Diffuse(albedo: Rgb(1.0, 1.0, 1.0))",
+        1.0,
+        ", kind: LightTracing",
+    );
+}

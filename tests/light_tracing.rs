@@ -5,7 +5,9 @@
 mod common;
 
 use assert_cmd::cargo::CommandCargoExt;
-use common::estimators::{GLOSSY, LAMPS, NO_SKY, THIN_LENS, agree, batch, load, side};
+use common::estimators::{
+    GLOSSY, GREY_SKY, LAMPS, NO_SKY, OUTDOOR, STUDIO_MAP, THIN_LENS, agree, batch, load, side,
+};
 use std::process::Command;
 
 /// The path tracer (`path_spp` per batch) and light tracing (`light_spp`) on every pixel.
@@ -56,6 +58,29 @@ fn glossy_materials() {
     agreement("glossy", GLOSSY, 48, &[], 32, 128);
 }
 
+/// Paths from a disc at infinity: the spectral sky and its sun, an environment map, a
+/// constant environment; the camera sees the environment itself along its rays. The ball is
+/// diffuse here: light tracing finds a glossy reflection of a bright environment only through
+/// rare light paths, an error too heavy-tailed for the z-test's variance estimate (at 8,192
+/// samples per pixel some of the plastic ball's pixels still err by 10 to 25 %).
+#[test]
+fn environment_lights() {
+    let ball = (
+        r#"entities["ball"].material"#,
+        "Diffuse(albedo: Rgb(0.1, 0.3, 0.6))",
+    );
+    agreement("sky and sun", OUTDOOR, 32, &[ball], 32, 64);
+    agreement("environment map", OUTDOOR, 32, &[ball, STUDIO_MAP], 32, 64);
+    agreement(
+        "constant environment",
+        OUTDOOR,
+        32,
+        &[ball, GREY_SKY],
+        32,
+        64,
+    );
+}
+
 /// The image is the same bits on one thread and on two: splats are summed in fixed point.
 #[test]
 fn same_image_on_one_and_two_threads() {
@@ -70,7 +95,7 @@ fn same_image_on_one_and_two_threads() {
     assert_eq!(on(1).pixels, on(2).pixels);
 }
 
-/// Media, an emitting environment and a target error are refused with one clear line.
+/// Media and a target error are refused with one clear line.
 #[test]
 fn unsupported_scenes_are_refused() {
     let dir = tempfile::tempdir().unwrap();
@@ -90,8 +115,6 @@ fn unsupported_scenes_are_refused() {
     };
     let e = run("scenes/fog_lamps.ron", &[]);
     assert!(e.contains("LightTracing") && e.contains("media"), "{e}");
-    let e = run("scenes/textures.ron", &[]);
-    assert!(e.contains("environment"), "{e}");
     let e = run(
         "scenes/cornell.ron",
         &["--target-error", "0.05", "--set", "render.width=8"],

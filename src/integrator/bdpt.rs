@@ -76,9 +76,14 @@ struct GlossyParts {
 
 /// A vertex of either subpath.
 struct Vtx<T: Transport, const N: usize> {
+    /// The point; at infinity, the unit direction towards it from the scene.
     p: Vec3,
+    /// On the environment: the light subpath's start there, or where the camera subpath
+    /// escaped.
+    inf: bool,
     /// The geometric normal, on the side the subpath arrived from (an area emitter's own
-    /// normal at the light subpath's start; zero at the camera and at a point light).
+    /// normal at the light subpath's start; zero at the camera, at a point light and at
+    /// infinity).
     ng: Vec3,
     /// Unit direction towards the previous vertex.
     wo: Vec3,
@@ -213,19 +218,29 @@ impl<'a, const N: usize> Bsdf<'a, N> {
     }
 }
 
-/// Converts a solid-angle density at `from` towards `to` into an area density at `to`.
-fn to_area(pdf: f32, from: Vec3, to: Vec3, n_to: Vec3) -> f32 {
-    let d = to - from;
+/// Converts a solid-angle density at `from` towards `to` into an area density at `to`. A
+/// direction at infinity keeps its solid-angle density; from infinity, `pdf` is the planar
+/// density of the parallel rays' origins, and only `to`'s cosine converts it.
+fn density<T: Transport, const N: usize>(pdf: f32, from: &Vtx<T, N>, to: &Vtx<T, N>) -> f32 {
+    if to.inf {
+        return pdf;
+    }
+    let cos_to = |w: Vec3| {
+        if to.ng == Vec3::ZERO {
+            1.0
+        } else {
+            to.ng.dot(w).abs()
+        }
+    };
+    if from.inf {
+        return pdf * cos_to(from.p);
+    }
+    let d = to.p - from.p;
     let r2 = d.length_squared();
     if r2 == 0.0 {
         return 0.0;
     }
-    let cos = if n_to == Vec3::ZERO {
-        1.0
-    } else {
-        n_to.dot(d).abs() / r2.sqrt()
-    };
-    pdf * cos / r2
+    pdf * cos_to(d / r2.sqrt()) / r2
 }
 
 /// Whether the segment between `a` and `b` is clear, each end offset off its surface (`na`,
@@ -337,26 +352,46 @@ fn walk<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool, co
         stats.lane_slots += 1;
         let hits = scene.intersect_packet::<f32, MOTION>(st.o, st.d, true, st.time);
         let sf = super::surface::surfaces::<f32, T, N, MOTION, false>(ctx, st, &hits, true);
+        let prev = path.len() - 1;
+        let dim = first_dim + st.depth * DIMS_PER_BOUNCE;
         if !sf.hit {
+            // The camera subpath that escapes meets the environment (s = 0).
+            if !LIGHT && scene.lights.has_infinite() {
+                let mut v = Vtx::<T, N> {
+                    p: st.d.lane(0).normalize(),
+                    inf: true,
+                    ng: Vec3::ZERO,
+                    wo: Vec3::ZERO,
+                    beta: st.beta,
+                    lam: st.lam,
+                    fwd: 0.0,
+                    rev: 0.0,
+                    delta: false,
+                    bsdf: None,
+                    emits: None,
+                    dim,
+                };
+                v.fwd = density(pdf_dir, &path[prev], &v);
+                path.push(v);
+            }
             break;
         }
-        let prev = path.len() - 1;
         let (p, ng) = (sf.p.lane(0), sf.nf.lane(0));
-        let fwd = to_area(pdf_dir, path[prev].p, p, ng);
-        let dim = first_dim + st.depth * DIMS_PER_BOUNCE;
         let mut v = Vtx::<T, N> {
             p,
+            inf: false,
             ng,
             wo: -st.d.lane(0),
             beta: st.beta,
             lam: st.lam,
-            fwd,
+            fwd: 0.0,
             rev: 0.0,
             delta: false,
             bsdf: None,
             emits: None,
             dim,
         };
+        v.fwd = density(pdf_dir, &path[prev], &v);
         if sf.class == CLASS_NONE {
             // Emitters absorb. The camera subpath keeps the hit for strategy s = 0.
             if !LIGHT && sf.emits {
@@ -417,8 +452,7 @@ fn walk<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool, co
         if !st.alive || path.len() >= max {
             break;
         }
-        let (pp, pn) = (path[prev].p, path[prev].ng);
-        path[prev].rev = to_area(rev, p, pp, pn);
+        path[prev].rev = density(rev, &path[prev + 1], &path[prev]);
     }
 }
 
@@ -514,6 +548,7 @@ fn sample<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
     cam.clear();
     cam.push(Vtx {
         p: o,
+        inf: false,
         ng: Vec3::ZERO,
         wo: Vec3::ZERO,
         beta: init,
@@ -545,8 +580,12 @@ fn sample<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
     );
     let chan = |s: T::S| super::bsdf::Chan(s.to_array());
     if let Some(e) = &emission {
+        // At infinity the vertex is the direction towards the light; its ray's origin on the
+        // disc is not a vertex.
+        let inf = matches!(e.emitter, super::light_tracer::Emitter::Infinite { .. });
         light.push(Vtx {
-            p: e.p,
+            p: if inf { -e.d } else { e.p },
+            inf,
             ng: e.n,
             wo: Vec3::ZERO,
             beta: init,
@@ -626,6 +665,9 @@ fn emitter_hit<T: Transport<S: ChannelArray<N>>, const N: usize>(
     weighted: bool,
 ) -> Option<Value<T, N>> {
     let pt = &cam[t - 1];
+    if pt.inf {
+        return environment_hit::<T, N>(ctx, cam, t, weighted);
+    }
     let (le, prim) = pt.emits?;
     let c = pt.beta * le;
     if c.is_zero() {
@@ -655,12 +697,47 @@ fn emitter_hit<T: Transport<S: ChannelArray<N>>, const N: usize>(
     let pdf_dir = pt.ng.dot(w).abs() / (PI * sides);
     let rev = Rev {
         pt: pmf / area,
-        pt_minus: to_area(pdf_dir, pt.p, prev.p, prev.ng),
+        pt_minus: density(pdf_dir, pt, prev),
         qs: 0.0,
         qs_minus: 0.0,
     };
     let w = mis_weight(cam, &[], 0, t, &rev, false);
     Some((c * w, pt.lam))
+}
+
+/// Strategy (0, t) at infinity: the camera subpath's vertex `t - 1` is a direction towards
+/// the environment. Each infinite light (the environment, the sun) is its own emitter, with
+/// its own weight.
+fn environment_hit<T: Transport<S: ChannelArray<N>>, const N: usize>(
+    ctx: &Ctx,
+    cam: &[Vtx<T, N>],
+    t: usize,
+    weighted: bool,
+) -> Option<Value<T, N>> {
+    use super::bsdf::LaneChannels;
+    let pt = &cam[t - 1];
+    let mut sum = C::<f32, N>::splat(0.0);
+    super::light_tracer::each_infinite(ctx, |light| {
+        let lam = T::lane(&pt.lam, 0);
+        let Some((le, pdf)) = super::light_tracer::infinite_light::<T>(ctx, light, &lam, pt.p)
+        else {
+            return;
+        };
+        let c = pt.beta * super::bsdf::Chan(le.to_array());
+        let w = if !weighted || t == 2 {
+            1.0
+        } else {
+            let rev = Rev {
+                pt: pdf,
+                pt_minus: density(ctx.scene.lights.disc_density(), pt, &cam[t - 2]),
+                qs: 0.0,
+                qs_minus: 0.0,
+            };
+            mis_weight(cam, &[], 0, t, &rev, false)
+        };
+        sum = sum + c * w;
+    });
+    (!sum.is_zero()).then_some((sum, pt.lam))
 }
 
 /// Strategy (s, 1): light vertex `s - 1` connects to the camera (a point on the lens drawn
@@ -700,16 +777,17 @@ fn light_to_camera<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTIO
             pt: 0.0,
             pt_minus: 0.0,
             qs: conn.importance * conn.wc.dot(qs.ng).abs(),
-            qs_minus: to_area(bsdf.pdf(conn.wc, qs.wo), qs.p, prev.p, prev.ng),
+            qs_minus: density(bsdf.pdf(conn.wc, qs.wo), qs, prev),
         };
         c = c * mis_weight(cam, light, s, 1, &rev, delta_light_of(light));
     }
     Some(((c, lam), (conn.fx, conn.fy)))
 }
 
-/// Whether the light subpath starts on a point or spot light (its start has no normal).
+/// Whether the light subpath starts on a point or spot light (its start has no normal and
+/// is not at infinity).
 fn delta_light_of<T: Transport, const N: usize>(light: &[Vtx<T, N>]) -> bool {
-    light.first().is_some_and(|v| v.ng == Vec3::ZERO)
+    light.first().is_some_and(|v| v.ng == Vec3::ZERO && !v.inf)
 }
 
 /// Strategies (s ≥ 1, t ≥ 2): camera vertex `t - 1` connects to light vertex `s - 1` (the
@@ -728,12 +806,17 @@ fn connect<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>
 ) -> Option<Value<T, N>> {
     let (pt, qs) = (&cam[t - 1], &light[s - 1]);
     let (sf_c, parts_c) = pt.bsdf.as_ref()?;
-    let d = qs.p - pt.p;
-    let r2 = d.length_squared();
-    if r2 == 0.0 {
-        return None;
-    }
-    let w = d / r2.sqrt();
+    // Towards a direction at infinity there is no distance to fall off with.
+    let (w, r2) = if qs.inf {
+        (qs.p, 1.0)
+    } else {
+        let d = qs.p - pt.p;
+        let r2 = d.length_squared();
+        if r2 == 0.0 {
+            return None;
+        }
+        (d / r2.sqrt(), r2)
+    };
     let bc = Bsdf::new(ctx, sf_c, parts_c);
     let (fc, pdf_c) = bc.camera_side(pt.wo, w)?;
     // The light side: the emitter's radiance (or intensity) at s = 1, else the adjoint BSDF.
@@ -759,7 +842,14 @@ fn connect<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>
         return None;
     }
     stats.shadow_rays += 1;
-    if !unoccluded::<MOTION>(ctx, pt.p, pt.ng, qs.p, qs.ng, time) {
+    let clear = if qs.inf {
+        let n = if pt.ng.dot(w) >= 0.0 { pt.ng } else { -pt.ng };
+        let ray = Ray::new(offset_ray_origin(pt.p, n), w);
+        !ctx.scene.occluded::<MOTION>(&ray, f32::INFINITY, time)
+    } else {
+        unoccluded::<MOTION>(ctx, pt.p, pt.ng, qs.p, qs.ng, time)
+    };
+    if !clear {
         return None;
     }
     let lam = joined::<T, N>(&pt.lam, &qs.lam, &mut c);
@@ -768,13 +858,13 @@ fn connect<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>
     }
     let cp = &cam[t - 2];
     let rev = Rev {
-        pt: to_area(pdf_l, qs.p, pt.p, pt.ng),
-        pt_minus: to_area(bc.pdf(w, pt.wo), pt.p, cp.p, cp.ng),
-        qs: to_area(pdf_c, pt.p, qs.p, qs.ng),
+        pt: density(pdf_l, qs, pt),
+        pt_minus: density(bc.pdf(w, pt.wo), pt, cp),
+        qs: density(pdf_c, pt, qs),
         qs_minus: match &bl {
             Some(bl) => {
                 let lp = &light[s - 2];
-                to_area(bl.pdf(-w, qs.wo), qs.p, lp.p, lp.ng)
+                density(bl.pdf(-w, qs.wo), qs, lp)
             }
             None => 0.0,
         },
@@ -877,7 +967,9 @@ pub fn choose(scene: &RenderScene) -> (Estimator, String) {
             "light {}",
             crate::components::quoted(&prims.names[p as usize])
         ),
-        _ => "a point light".into(),
+        LightKind::Point(_) => "a point light".into(),
+        LightKind::Sun => "the sun".into(),
+        LightKind::Environment(_) | LightKind::EnvMap => "the environment".into(),
     };
     (
         Estimator::Bdpt,
@@ -900,6 +992,7 @@ mod tests {
     fn vtx(fwd: f32, rev: f32, delta: bool) -> Vtx<Rgb, 3> {
         Vtx {
             p: Vec3::ZERO,
+            inf: false,
             ng: Vec3::ZERO,
             wo: Vec3::ZERO,
             beta: C::<f32, 3>::splat(1.0),

@@ -37,18 +37,10 @@ use std::sync::atomic::Ordering;
 use std::time::Instant;
 
 /// Why the scene cannot be rendered from the lights (light tracing, BDPT), if it cannot
-/// (yet): media and an emitting environment.
+/// (yet): participating media.
 pub fn unsupported(scene: &RenderScene) -> Option<String> {
     if scene.effects.has(crate::scene::Effect::Media) {
         return Some("paths from the lights do not handle participating media yet".into());
-    }
-    if scene.lights.lights.iter().any(|l| {
-        matches!(
-            l,
-            LightKind::Environment(_) | LightKind::EnvMap | LightKind::Sun
-        )
-    }) {
-        return Some("paths from the lights do not start on the environment yet".into());
     }
     None
 }
@@ -348,6 +340,9 @@ pub(super) enum Emitter {
         pl: crate::components::PointLight,
         light: u32,
     },
+    /// The environment or the sun, light index `light`: a direction at infinity, the path's
+    /// origin drawn on a disc of the scene's bounding radius facing it.
+    Infinite { light: u32 },
 }
 
 /// A point and direction drawn on an emitter, with the throughput of the path they start.
@@ -365,7 +360,10 @@ pub(super) struct Emission<S> {
     pub(super) two_sided: bool,
     pub(super) emitter: Emitter,
     /// The densities of choosing the emitter and the point (area measure; the choice alone
-    /// at a point light), and of the direction `d` (solid angle).
+    /// at a point light), and of the direction `d` (solid angle). At infinity the roles
+    /// swap, as the path's vertices see them: `pdf_pos` is the density of the direction
+    /// (solid angle, with the choice of the light) and `pdf_dir` that of the origin on the
+    /// disc (planar).
     pub(super) pdf_pos: f32,
     pub(super) pdf_dir: f32,
 }
@@ -492,7 +490,61 @@ impl<S> Emission<S> {
                     pdf,
                 ))
             }
+            Emitter::Infinite { light } => {
+                let (le, _) = infinite_light::<T>(ctx, light, lam, -w)?;
+                Some((le, ctx.scene.lights.disc_density()))
+            }
         }
+    }
+}
+
+/// Infinite light `light` (the environment or the sun) seen along unit `wi` (towards it):
+/// its radiance in the transport's channels, and the density with which light sampling (and
+/// a light path's start) draws `wi` from it, with the probability of choosing it. `None`
+/// where it sends nothing.
+pub(super) fn infinite_light<T: Transport>(
+    ctx: &Ctx,
+    light: u32,
+    lam: &T::Lambda,
+    wi: Vec3,
+) -> Option<(T::S, f32)> {
+    let lights = &ctx.scene.lights;
+    let pmf = lights.table.pmf(light as usize);
+    let (rgb, source, pdf) = match lights.lights[light as usize] {
+        LightKind::Environment(l) => (
+            l,
+            LightSource::Environment,
+            crate::sampling::uniform_sphere_pdf(),
+        ),
+        LightKind::EnvMap => {
+            let map = lights.map.as_deref()?;
+            // A sky's radiance is the model's, not its tabulation's.
+            let rgb = lights
+                .sky
+                .as_deref()
+                .map_or_else(|| map.eval(wi), |s| s.rgb(wi));
+            (rgb, LightSource::EnvMap { wi }, map.pdf(wi))
+        }
+        LightKind::Sun => {
+            let sky = lights.sky.as_deref()?;
+            if !sky.on_sun(wi) {
+                return None;
+            }
+            (sky.sun_rgb(), LightSource::Sun, 1.0 / sky.sun_solid_angle())
+        }
+        LightKind::Area(_) | LightKind::Point(_) => return None,
+    };
+    if rgb == Vec3::ZERO || pdf.is_nan() || pdf <= 0.0 {
+        return None;
+    }
+    Some((T::source_radiance(ctx, &source, rgb, lam), pmf * pdf))
+}
+
+/// Calls `f` with each infinite light's index: the environment's, then the sun's.
+pub(super) fn each_infinite(ctx: &Ctx, mut f: impl FnMut(u32)) {
+    let lights = &ctx.scene.lights;
+    for i in [lights.environment, lights.sun].into_iter().flatten() {
+        f(i);
     }
 }
 
@@ -626,7 +678,35 @@ pub(super) fn emit<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTIO
                 pdf_dir: local.z / (PI * sides),
             })
         }
-        LightKind::Environment(_) | LightKind::EnvMap | LightKind::Sun => None,
+        LightKind::Environment(_) | LightKind::EnvMap | LightKind::Sun => {
+            // A direction drawn as light sampling draws it, then an origin uniform on the disc
+            // of the scene's bounding radius facing it, one radius beyond the centre.
+            let wi = match lights.lights[i] {
+                LightKind::Environment(_) => crate::sampling::square_to_uniform_sphere(u_dir),
+                LightKind::EnvMap => lights.map.as_deref()?.sample(u_dir)?.0,
+                _ => lights.sky.as_deref()?.sample_sun(u_dir),
+            };
+            let (le, pdf) = infinite_light::<T>(ctx, i as u32, lam, wi)?;
+            let (centre, r) = lights.sphere;
+            let disc = crate::sampling::square_to_uniform_disk_concentric(u_pos);
+            let (a, b) = wi.any_orthonormal_pair();
+            let p = centre + (wi + a * disc.x + b * disc.y) * r;
+            let planar = lights.disc_density();
+            if !(p.is_finite() && planar > 0.0) {
+                return None;
+            }
+            Some(Emission {
+                p,
+                n: Vec3::ZERO,
+                d: -wi,
+                beta: le * (1.0 / (pdf * planar)),
+                le: T::S::from_array([0.0; N]),
+                two_sided: false,
+                emitter: Emitter::Infinite { light: i as u32 },
+                pdf_pos: pdf,
+                pdf_dir: planar,
+            })
+        }
     }
 }
 
@@ -647,6 +727,7 @@ fn trace_tile<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bo
         dropped: 0,
     };
     let max_depth = ctx.max_depth;
+    let infinite = scene.lights.has_infinite();
     for p in 0..tile.pixels() {
         let (x, y) = tile.pixel(p);
         let (first, count) = work.range(p);
@@ -661,6 +742,34 @@ fn trace_tile<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bo
                 scene.shutter.0
             };
             let lam = T::wavelengths::<f32>(ctx, pixel, index);
+            let init = T::initial_beta::<f32, N>(&lam);
+            let chan = |s: T::S| super::bsdf::Chan(s.to_array());
+            if infinite {
+                // No light path reaches the pinhole from infinity: the camera ray looks up
+                // the environment it sees directly.
+                let ray =
+                    super::generate::camera_rays_keyed::<f32, MOTION>(ctx, x, y, pixel, index);
+                let (o, d) = (ray.o.lane(0), ray.d.lane(0).normalize());
+                stats.rays += 1;
+                if scene
+                    .intersect::<MOTION>(&Ray::new(o, d), f32::INFINITY, time)
+                    .is_none()
+                {
+                    let mut c = C::<f32, N>::splat(0.0);
+                    each_infinite(ctx, |i| {
+                        if let Some((le, _)) = infinite_light::<T>(ctx, i, &T::lane(&lam, 0), d) {
+                            c = c + init * chan(le);
+                        }
+                    });
+                    let mut rgb = [Vec3::ZERO; MAX_W];
+                    T::ended_rgb(&c, &lam, 1, &mut rgb);
+                    if rgb[0].is_finite() {
+                        vertex.splats.add_pixel(x, y, rgb[0]);
+                    } else {
+                        vertex.dropped += 1;
+                    }
+                }
+            }
             // The emission takes the dimensions of event 0; the path's events follow.
             let dim = DIM_BOUNCE;
             let sampler = &ctx.sampler;
@@ -677,8 +786,6 @@ fn trace_tile<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bo
             ) else {
                 continue;
             };
-            let init = T::initial_beta::<f32, N>(&lam);
-            let chan = |s: T::S| super::bsdf::Chan(s.to_array());
             // The emitter seen by the camera: a point light is not, as in the path tracer.
             if e.n != Vec3::ZERO {
                 let u = sampler.get_2d_lanes::<f32>(pixel, index, dim + 6);

@@ -85,6 +85,9 @@ pub struct Lights {
     pub sky: Option<std::sync::Arc<super::sky::Sky>>,
     /// Index of the sun's light, if the sky has a sun.
     pub sun: Option<u32>,
+    /// The bounding sphere of the scene's geometry (centre, radius): light paths from the
+    /// environment start on a disc of its radius facing the scene, as pbrt's do.
+    pub sphere: (Vec3, f32),
 }
 
 impl Lights {
@@ -394,6 +397,17 @@ impl Lights {
                 None => pmf * crate::sampling::uniform_sphere_pdf(),
             }
         })
+    }
+
+    /// Whether the environment (or the sun) emits.
+    pub fn has_infinite(&self) -> bool {
+        self.environment.is_some() || self.sun.is_some()
+    }
+
+    /// The density of a light path's origin on the disc at infinity, per unit area of the
+    /// disc (planar: the rays are parallel).
+    pub fn disc_density(&self) -> f32 {
+        1.0 / (std::f32::consts::PI * self.sphere.1 * self.sphere.1)
     }
 
     /// Density of sampling direction `wi` (unit length) towards the sun (zero off its disc).

@@ -56,10 +56,13 @@ pub fn gather_lights(
     let mut env_index = None;
     // As pbrt does, an infinite light's power is that of a disc the size of the scene facing
     // it from every direction (or from the sun's).
-    let r = if scene_bounds.is_empty() {
-        1.0
+    let (centre, r) = if scene_bounds.is_empty() {
+        (Vec3::ZERO, 1.0)
     } else {
-        0.5 * scene_bounds.diagonal().length()
+        (
+            scene_bounds.center(),
+            (0.5 * scene_bounds.diagonal().length()).max(1e-6),
+        )
     };
     let map = map.filter(|m| m.emits());
     let (kind, radiance) = match map {
@@ -92,5 +95,6 @@ pub fn gather_lights(
         map: map.cloned(),
         sky: sky.cloned(),
         sun,
+        sphere: (centre, r),
     }
 }

@@ -215,3 +215,29 @@ pub const GLOSSY: &str = r#"Scene(
          material: Conductor(metal: Ni, alpha: (0.2, 0.4))),
     ],
 )"#;
+
+/// Outdoors under the spectral daylight sky and its sun: diffuse blocks and a rough plastic
+/// ball on a ground of finite size. Other environments replace the sky with an override.
+pub const OUTDOOR: &str = r#"Scene(
+    render: (width: 24, height: 24, spp: 16, max_depth: 6, seed: 1),
+    camera: (position: (0.0, 1.4, -4.0), look_at: (0.0, 0.5, 0.0), fov_y: 45.0),
+    environment: Sky(sun_elevation: 35.0, sun_azimuth: 150.0, turbidity: 3.0,
+                     ground_albedo: Rgb(0.3, 0.3, 0.3), sun: true, scale: 2.0),
+    entities: [
+        (name: "ground", shape: Rect(center: (0.0, 0.0, 0.0), u: (3.0, 0.0, 0.0), v: (0.0, 0.0, -3.0)),
+         material: Diffuse(albedo: Rgb(0.5, 0.48, 0.45))),
+        (name: "block", shape: Box(min: (0.4, 0.0, 0.2), max: (1.4, 1.2, 1.2)),
+         material: Diffuse(albedo: Rgb(0.7, 0.45, 0.3))),
+        (name: "ball", shape: Sphere(center: (-0.7, 0.5, 0.0), radius: 0.5),
+         material: Plastic(albedo: Rgb(0.1, 0.3, 0.6), roughness: 0.3)),
+    ],
+)"#;
+
+/// The studio's environment map in place of [`OUTDOOR`]'s sky.
+pub const STUDIO_MAP: (&str, &str) = (
+    "environment",
+    r#"Image(path: "../assets/env/studio.exr", scale: 1.0, rotate: (0.0, 40.0, 0.0))"#,
+);
+
+/// A constant environment in place of [`OUTDOOR`]'s sky.
+pub const GREY_SKY: (&str, &str) = ("environment", "Constant(Rgb(0.6, 0.7, 0.8))");
