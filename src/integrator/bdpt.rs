@@ -3,7 +3,7 @@
 //! of the light subpath and the first `t` of the camera subpath:
 //!
 //! - `s = 0`: the camera subpath hits an emitter;
-//! - `s = 1`: a camera vertex connects to the light subpath's point on the emitter;
+//! - `s = 1`: a camera vertex samples a light point of its own, as next-event estimation does;
 //! - `t = 1`: a light vertex connects to the camera and splats, as light tracing does;
 //! - otherwise a camera vertex and a light vertex connect through a shadow ray.
 //!
@@ -22,7 +22,7 @@
 use super::bsdf::{Frame, Mode};
 use super::ctx::{Ctx, DIM_BOUNCE, DIMS_PER_BOUNCE};
 use super::light::Glossy;
-use super::light_tracer::{Camera, Emission, Splats, path_state};
+use super::light_tracer::{Camera, Splats, path_state};
 use super::material::{self, Vertex};
 use super::microfacet::RoughDielectric;
 use super::state::{C, M, MAX_W, Paths, U};
@@ -150,6 +150,7 @@ struct Bsdf<'a, const N: usize> {
 }
 
 impl<'a, const N: usize> Bsdf<'a, N> {
+    #[inline(always)]
     fn new(ctx: &'a Ctx, sf: &'a Surface<f32, N>, g: &GlossyParts) -> Self {
         Bsdf {
             sf,
@@ -164,6 +165,7 @@ impl<'a, const N: usize> Bsdf<'a, N> {
         }
     }
 
+    #[inline(always)]
     fn local(&self, w: Vec3) -> V3<f32> {
         self.frame.to_local(V3::splat(w))
     }
@@ -171,6 +173,7 @@ impl<'a, const N: usize> Bsdf<'a, N> {
     /// The solid-angle density of sampling `wi` given `wo` (world directions). From the far
     /// side of a rough dielectric (a reverse density across the interface) it is the
     /// interface seen from there: the normal flipped and the relative IOR inverted.
+    #[inline(always)]
     fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
         let (wo, wi) = (self.local(wo), self.local(wi));
         if self.glossy.dielectric && wo.z < 0.0 {
@@ -185,6 +188,7 @@ impl<'a, const N: usize> Bsdf<'a, N> {
     /// At a camera vertex: f |cos| towards `wi` seen from `wo`, with next-event estimation's
     /// rules (above both normals, or through a rough dielectric), and the density of
     /// sampling `wi`.
+    #[inline(always)]
     fn camera_side(&self, wo: Vec3, wi: Vec3) -> Option<(C<f32, N>, f32)> {
         let (wo_l, wi_l) = (self.local(wo), self.local(wi));
         let side = wi.dot(self.sf.nf.lane(0));
@@ -199,6 +203,7 @@ impl<'a, const N: usize> Bsdf<'a, N> {
     /// At a light vertex reached from `wl`: the adjoint BSDF towards `wc` with Veach's
     /// shading-normal factor, f |wl·n_s| |wc·n_g| / |wl·n_g| (light tracing's rules), and
     /// the density of sampling `wc`.
+    #[inline(always)]
     fn light_side(&self, wl: Vec3, wc: Vec3) -> Option<(C<f32, N>, f32)> {
         let (wl_l, wc_l) = (self.local(wl), self.local(wc));
         let ng = self.sf.nf.lane(0);
@@ -221,6 +226,7 @@ impl<'a, const N: usize> Bsdf<'a, N> {
 /// Converts a solid-angle density at `from` towards `to` into an area density at `to`. A
 /// direction at infinity keeps its solid-angle density; from infinity, `pdf` is the planar
 /// density of the parallel rays' origins, and only `to`'s cosine converts it.
+#[inline(always)]
 fn density<T: Transport, const N: usize>(pdf: f32, from: &Vtx<T, N>, to: &Vtx<T, N>) -> f32 {
     if to.inf {
         return pdf;
@@ -245,6 +251,7 @@ fn density<T: Transport, const N: usize>(pdf: f32, from: &Vtx<T, N>, to: &Vtx<T,
 
 /// Whether the segment between `a` and `b` is clear, each end offset off its surface (`na`,
 /// `nb`; zero at the lens and at a point light).
+#[inline(always)]
 fn unoccluded<const MOTION: bool>(ctx: &Ctx, a: Vec3, na: Vec3, b: Vec3, nb: Vec3, t: f32) -> bool {
     let d = b - a;
     let off = |p: Vec3, n: Vec3, towards: Vec3| {
@@ -281,6 +288,7 @@ struct Rev {
 /// ratio of the densities with which the neighbouring strategy and this one sample a vertex.
 /// Strategies that would connect at a delta vertex (or start on a delta light's point by
 /// hitting it) are not counted.
+#[inline(always)]
 fn mis_weight<T: Transport, const N: usize>(
     cam: &[Vtx<T, N>],
     light: &[Vtx<T, N>],
@@ -337,6 +345,7 @@ fn mis_weight<T: Transport, const N: usize>(
 /// vertices; `pdf_dir` is the solid-angle density of the first ray. `LIGHT` subpaths carry
 /// importance.
 #[allow(clippy::too_many_arguments)]
+#[inline(always)]
 fn walk<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool, const LIGHT: bool>(
     ctx: &Ctx,
     st: &mut Paths<f32, T, N>,
@@ -457,6 +466,7 @@ fn walk<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool, co
 }
 
 /// Carries a termination of the secondary wavelengths at vertex `v`'s event into `v`.
+#[inline(always)]
 fn lift_termination<T: Transport<S: ChannelArray<N>>, const N: usize>(
     st: &Paths<f32, T, N>,
     v: &mut Vtx<T, N>,
@@ -467,6 +477,7 @@ fn lift_termination<T: Transport<S: ChannelArray<N>>, const N: usize>(
 }
 
 /// The wavelengths of a connection: the hero alone if either side's have ended.
+#[inline(always)]
 fn joined<T: Transport<S: ChannelArray<N>>, const N: usize>(
     a: &T::Lanes<f32>,
     b: &T::Lanes<f32>,
@@ -560,9 +571,21 @@ fn sample<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
         emits: None,
         dim: 0,
     });
+    let lanes = crate::simd::Lanes::scalar();
     let mut st = path_state::<T, N>(o, d, init, lam, 1.0, time, pixel, index);
     let pdf_cam = camera.pdf_dir::<MOTION>(time, d);
-    walk::<T, N, MOTION, false>(ctx, &mut st, cam, max_depth + 2, pdf_cam, DIM_BOUNCE, stats);
+    super::run_at(
+        lanes,
+        Walk::<T, N, MOTION, false> {
+            ctx,
+            st: &mut st,
+            path: cam,
+            max: max_depth + 2,
+            pdf_dir: pdf_cam,
+            first_dim: DIM_BOUNCE,
+            stats,
+        },
+    );
     // The light subpath.
     let light = &mut paths.light;
     light.clear();
@@ -582,7 +605,7 @@ fn sample<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
     if let Some(e) = &emission {
         // At infinity the vertex is the direction towards the light; its ray's origin on the
         // disc is not a vertex.
-        let inf = matches!(e.emitter, super::light_tracer::Emitter::Infinite { .. });
+        let inf = e.at_infinity;
         light.push(Vtx {
             p: if inf { -e.d } else { e.p },
             inf,
@@ -599,21 +622,118 @@ fn sample<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
         });
         if max_depth >= 1 {
             let mut st = e.path::<T, N>(init * chan(e.beta), lam, time, pixel, index);
-            walk::<T, N, MOTION, true>(
-                ctx,
-                &mut st,
-                light,
-                max_depth + 1,
-                e.pdf_dir,
-                DIM_LIGHT_PATH + DIMS_PER_BOUNCE,
-                stats,
+            super::run_at(
+                lanes,
+                Walk::<T, N, MOTION, true> {
+                    ctx,
+                    st: &mut st,
+                    path: light,
+                    max: max_depth + 1,
+                    pdf_dir: e.pdf_dir,
+                    first_dim: DIM_LIGHT_PATH + DIMS_PER_BOUNCE,
+                    stats,
+                },
             );
         }
     }
+    super::run_at(
+        lanes,
+        Joins::<T, N, MOTION> {
+            ctx,
+            camera,
+            which,
+            paths,
+            key: (pixel, index),
+            time,
+            splats,
+            stats,
+        },
+    )
+}
+
+/// A subpath's walk, run inside the width-1 FMA entry point (see [`Joins`]).
+struct Walk<'a, 'c, T: Transport, const N: usize, const MOTION: bool, const LIGHT: bool> {
+    ctx: &'a Ctx<'c>,
+    st: &'a mut Paths<f32, T, N>,
+    path: &'a mut Vec<Vtx<T, N>>,
+    max: usize,
+    pdf_dir: f32,
+    first_dim: u32,
+    stats: &'a mut RenderStats,
+}
+
+impl<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool, const LIGHT: bool>
+    crate::simd::LaneKernel for Walk<'_, '_, T, N, MOTION, LIGHT>
+{
+    type Output = ();
+    #[inline(always)]
+    fn run<F: crate::simd::Float>(self) {
+        walk::<T, N, MOTION, LIGHT>(
+            self.ctx,
+            self.st,
+            self.path,
+            self.max,
+            self.pdf_dir,
+            self.first_dim,
+            self.stats,
+        );
+    }
+}
+
+/// Every strategy of one sample's subpaths, run inside the width-1 FMA entry point: width-1
+/// code outside the lanes' entry points calls libm for each `f32::mul_add`. The walks and
+/// the joins are three entries per sample rather than one, which keeps each function the
+/// compiler optimises of a size it handles quickly.
+struct Joins<'a, 'c, T: Transport, const N: usize, const MOTION: bool> {
+    ctx: &'a Ctx<'c>,
+    camera: &'a Camera<'c>,
+    which: Strategies,
+    paths: &'a Subpaths<T, N>,
+    key: (u32, u32),
+    time: f32,
+    splats: &'a mut Splats,
+    stats: &'a mut RenderStats,
+}
+
+impl<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool> crate::simd::LaneKernel
+    for Joins<'_, '_, T, N, MOTION>
+{
+    type Output = Vec3;
+    #[inline(always)]
+    fn run<F: crate::simd::Float>(self) -> Vec3 {
+        joins::<T, N, MOTION>(
+            self.ctx,
+            self.camera,
+            self.which,
+            self.paths,
+            self.key,
+            self.time,
+            self.splats,
+            self.stats,
+        )
+    }
+}
+
+/// Every strategy (s, t) that `which` asks for over `paths`: the value of the sample's own
+/// pixel, the t = 1 strategies splatted where they land.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn joins<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
+    ctx: &Ctx,
+    camera: &Camera,
+    which: Strategies,
+    paths: &Subpaths<T, N>,
+    (pixel, index): (u32, u32),
+    time: f32,
+    splats: &mut Splats,
+    stats: &mut RenderStats,
+) -> Vec3 {
+    let max_depth = ctx.max_depth as usize;
     let mut own = Vec3::ZERO;
     let (cam, light) = (&paths.cam, &paths.light);
     for t in 1..=cam.len() {
-        for s in 0..=light.len() {
+        // s = 1 samples its own light point, with or without a light subpath.
+        for s in 0..=light.len().max(1) {
             let depth = s as i64 + t as i64 - 2;
             if (s == 1 && t == 1) || depth < 0 || depth > max_depth as i64 {
                 continue;
@@ -642,10 +762,10 @@ fn sample<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
                 }
                 continue;
             }
-            let got = if s == 0 {
-                emitter_hit::<T, N>(ctx, cam, t, all)
-            } else {
-                connect::<T, N, MOTION>(ctx, cam, light, emission.as_ref(), s, t, all, time, stats)
+            let got = match s {
+                0 => emitter_hit::<T, N>(ctx, cam, t, all),
+                1 => light_sample::<T, N, MOTION>(ctx, cam, t, all, (pixel, index), time, stats),
+                _ => connect::<T, N, MOTION>(ctx, cam, light, s, t, all, time, stats),
             };
             if let Some((c, lam)) = got {
                 let mut rgb = [Vec3::ZERO; MAX_W];
@@ -658,6 +778,7 @@ fn sample<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
 }
 
 /// Strategy (0, t): the camera subpath's vertex `t - 1` is an emitter.
+#[inline(always)]
 fn emitter_hit<T: Transport<S: ChannelArray<N>>, const N: usize>(
     ctx: &Ctx,
     cam: &[Vtx<T, N>],
@@ -708,6 +829,7 @@ fn emitter_hit<T: Transport<S: ChannelArray<N>>, const N: usize>(
 /// Strategy (0, t) at infinity: the camera subpath's vertex `t - 1` is a direction towards
 /// the environment. Each infinite light (the environment, the sun) is its own emitter, with
 /// its own weight.
+#[inline(always)]
 fn environment_hit<T: Transport<S: ChannelArray<N>>, const N: usize>(
     ctx: &Ctx,
     cam: &[Vtx<T, N>],
@@ -743,6 +865,7 @@ fn environment_hit<T: Transport<S: ChannelArray<N>>, const N: usize>(
 /// Strategy (s, 1): light vertex `s - 1` connects to the camera (a point on the lens drawn
 /// from the event's dimensions). Returns the value, its wavelengths and the raster point.
 #[allow(clippy::too_many_arguments)]
+#[inline(always)]
 fn light_to_camera<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
     ctx: &Ctx,
     camera: &Camera,
@@ -786,6 +909,7 @@ fn light_to_camera<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTIO
 
 /// Whether the light subpath starts on a point or spot light (its start has no normal and
 /// is not at infinity).
+#[inline(always)]
 fn delta_light_of<T: Transport, const N: usize>(light: &[Vtx<T, N>]) -> bool {
     light.first().is_some_and(|v| v.ng == Vec3::ZERO && !v.inf)
 }
@@ -793,11 +917,11 @@ fn delta_light_of<T: Transport, const N: usize>(light: &[Vtx<T, N>]) -> bool {
 /// Strategies (s ≥ 1, t ≥ 2): camera vertex `t - 1` connects to light vertex `s - 1` (the
 /// point on the emitter when s = 1) through a shadow ray.
 #[allow(clippy::too_many_arguments)]
+#[inline(always)]
 fn connect<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
     ctx: &Ctx,
     cam: &[Vtx<T, N>],
     light: &[Vtx<T, N>],
-    emission: Option<&Emission<T::S>>,
     s: usize,
     t: usize,
     weighted: bool,
@@ -806,50 +930,24 @@ fn connect<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>
 ) -> Option<Value<T, N>> {
     let (pt, qs) = (&cam[t - 1], &light[s - 1]);
     let (sf_c, parts_c) = pt.bsdf.as_ref()?;
-    // Towards a direction at infinity there is no distance to fall off with.
-    let (w, r2) = if qs.inf {
-        (qs.p, 1.0)
-    } else {
-        let d = qs.p - pt.p;
-        let r2 = d.length_squared();
-        if r2 == 0.0 {
-            return None;
-        }
-        (d / r2.sqrt(), r2)
-    };
+    let d = qs.p - pt.p;
+    let r2 = d.length_squared();
+    if r2 == 0.0 {
+        return None;
+    }
+    let w = d / r2.sqrt();
     let bc = Bsdf::new(ctx, sf_c, parts_c);
     let (fc, pdf_c) = bc.camera_side(pt.wo, w)?;
-    // The light side: the emitter's radiance (or intensity) at s = 1, else the adjoint BSDF.
-    let (fl, pdf_l, bl) = if s == 1 {
-        let e = emission?;
-        let (le, pdf_dir) = e.toward::<T>(ctx, &T::lane(&qs.lam, 0), -w)?;
-        let cos = if qs.ng == Vec3::ZERO {
-            1.0
-        } else {
-            qs.ng.dot(w).abs()
-        };
-        // Over the densities of the emitter and the point: `qs.fwd`.
-        let le = qs.beta * super::bsdf::Chan(le.to_array()) * (cos / qs.fwd);
-        (le, pdf_dir, None)
-    } else {
-        let (sf_l, parts_l) = qs.bsdf.as_ref()?;
-        let bl = Bsdf::new(ctx, sf_l, parts_l);
-        let (f, pdf) = bl.light_side(qs.wo, -w)?;
-        (qs.beta * f, pdf, Some(bl))
-    };
-    let mut c = pt.beta * fc * fl * (1.0 / r2);
+    // The light side: the adjoint BSDF.
+    let (sf_l, parts_l) = qs.bsdf.as_ref()?;
+    let bl = Bsdf::new(ctx, sf_l, parts_l);
+    let (fl, pdf_l) = bl.light_side(qs.wo, -w)?;
+    let mut c = pt.beta * fc * qs.beta * fl * (1.0 / r2);
     if c.is_zero() {
         return None;
     }
     stats.shadow_rays += 1;
-    let clear = if qs.inf {
-        let n = if pt.ng.dot(w) >= 0.0 { pt.ng } else { -pt.ng };
-        let ray = Ray::new(offset_ray_origin(pt.p, n), w);
-        !ctx.scene.occluded::<MOTION>(&ray, f32::INFINITY, time)
-    } else {
-        unoccluded::<MOTION>(ctx, pt.p, pt.ng, qs.p, qs.ng, time)
-    };
-    if !clear {
+    if !unoccluded::<MOTION>(ctx, pt.p, pt.ng, qs.p, qs.ng, time) {
         return None;
     }
     let lam = joined::<T, N>(&pt.lam, &qs.lam, &mut c);
@@ -861,16 +959,129 @@ fn connect<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>
         pt: density(pdf_l, qs, pt),
         pt_minus: density(bc.pdf(w, pt.wo), pt, cp),
         qs: density(pdf_c, pt, qs),
-        qs_minus: match &bl {
-            Some(bl) => {
-                let lp = &light[s - 2];
-                density(bl.pdf(-w, qs.wo), qs, lp)
-            }
-            None => 0.0,
-        },
+        qs_minus: density(bl.pdf(-w, qs.wo), qs, &light[s - 2]),
     };
     let weight = mis_weight(cam, light, s, t, &rev, delta_light_of(light));
     Some((c * weight, lam))
+}
+
+/// Strategy (1, t): camera vertex `t - 1` samples a light as next-event estimation does (its
+/// own point, by solid angle where the light allows). Its weight treats that point as the
+/// light subpath's start, with that start's densities: MIS stays unbiased with any densities
+/// so long as every strategy of a path is weighted by the same ones (pbrt does the same).
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn light_sample<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
+    ctx: &Ctx,
+    cam: &[Vtx<T, N>],
+    t: usize,
+    weighted: bool,
+    key: (u32, u32),
+    time: f32,
+    stats: &mut RenderStats,
+) -> Option<Value<T, N>> {
+    let pt = &cam[t - 1];
+    let (sf_c, parts_c) = pt.bsdf.as_ref()?;
+    let scene = ctx.scene;
+    // The camera subpath's walk leaves each event's light dimensions unused.
+    let u_sel = ctx.sampler.get_1d_lanes::<f32>(key.0, key.1, pt.dim);
+    let u = ctx.sampler.get_2d_lanes::<f32>(key.0, key.1, pt.dim + 1);
+    let ls = scene.lights.sample::<MOTION>(
+        &scene.prims,
+        pt.p,
+        u_sel,
+        Vec2::new(u.0, u.1),
+        time,
+        ctx.textures,
+    )?;
+    let w = ls.wi;
+    let bc = Bsdf::new(ctx, sf_c, parts_c);
+    let (fc, pdf_c) = bc.camera_side(pt.wo, w)?;
+    let le = T::source_radiance(ctx, &ls.source, ls.radiance, &T::lane(&pt.lam, 0));
+    let c = pt.beta * fc * super::bsdf::Chan(le.to_array()) * (1.0 / ls.pdf);
+    if c.is_zero() {
+        return None;
+    }
+    stats.shadow_rays += 1;
+    let clear = match ls.point {
+        Some((q, n)) => unoccluded::<MOTION>(ctx, pt.p, pt.ng, q, n, time),
+        None => {
+            let n = if pt.ng.dot(w) >= 0.0 { pt.ng } else { -pt.ng };
+            let ray = Ray::new(offset_ray_origin(pt.p, n), w);
+            !scene.occluded::<MOTION>(&ray, f32::INFINITY, time)
+        }
+    };
+    if !clear {
+        return None;
+    }
+    if !weighted {
+        return Some((c, pt.lam));
+    }
+    let (qs, pdf_l) = light_start::<T, N>(ctx, &ls, pt)?;
+    let rev = Rev {
+        pt: density(pdf_l, &qs, pt),
+        pt_minus: density(bc.pdf(w, pt.wo), pt, &cam[t - 2]),
+        qs: density(pdf_c, pt, &qs),
+        qs_minus: 0.0,
+    };
+    let weight = mis_weight(cam, std::slice::from_ref(&qs), 1, t, &rev, ls.delta);
+    Some((c * weight, pt.lam))
+}
+
+/// The light sample `ls` taken from `pt` as a light subpath's start: its vertex (with the
+/// density of choosing the light and the point, or at infinity the direction), and the
+/// density with which the emission would have sent its ray towards `pt`.
+#[inline(always)]
+fn light_start<T: Transport, const N: usize>(
+    ctx: &Ctx,
+    ls: &crate::scene::lights::LightSample,
+    pt: &Vtx<T, N>,
+) -> Option<(Vtx<T, N>, f32)> {
+    use crate::scene::lights::LightSource;
+    let lights = &ctx.scene.lights;
+    let prims = &ctx.scene.prims;
+    let vertex = |p: Vec3, ng: Vec3, inf: bool, fwd: f32| Vtx::<T, N> {
+        p,
+        inf,
+        ng,
+        wo: Vec3::ZERO,
+        beta: pt.beta,
+        lam: pt.lam,
+        fwd,
+        rev: 0.0,
+        delta: false,
+        bsdf: None,
+        emits: None,
+        dim: 0,
+    };
+    match (ls.source, ls.point) {
+        (LightSource::Area { prim, material, .. }, Some((q, n))) => {
+            let pmf = lights.table.pmf(prims.light[prim as usize] as usize);
+            let area = crate::scene::lights::emitter_area(prims, prim);
+            let sides = match prims.materials[material as usize] {
+                Material::Light {
+                    two_sided: true, ..
+                } => 2.0,
+                _ => 1.0,
+            };
+            let pdf_dir = n.dot(ls.wi).abs() / (PI * sides);
+            Some((vertex(q, n, false, pmf / area), pdf_dir))
+        }
+        (LightSource::Point { light, .. }, Some((q, _))) => {
+            let LightKind::Point(pl) = lights.lights[light as usize] else {
+                return None;
+            };
+            let pmf = lights.table.pmf(light as usize);
+            let pdf_dir = super::light_tracer::point_emission_pdf(&pl, -ls.wi);
+            Some((vertex(q, Vec3::ZERO, false, pmf), pdf_dir))
+        }
+        // The environment and the sun: `ls.pdf` is the direction's density with the choice.
+        (_, None) => Some((
+            vertex(ls.wi, Vec3::ZERO, true, ls.pdf),
+            lights.disc_density(),
+        )),
+        _ => None,
+    }
 }
 
 /// Renders `opts.spp` samples per pixel by BDPT (fewer if stopped or out of time), in

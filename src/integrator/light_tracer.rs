@@ -33,6 +33,7 @@ use crate::simd::V3;
 use glam::{Vec2, Vec3};
 use rayon::prelude::*;
 use std::f32::consts::PI;
+use std::marker::PhantomData;
 use std::sync::atomic::Ordering;
 use std::time::Instant;
 
@@ -67,6 +68,7 @@ impl Splats {
 
     /// Adds `rgb` to pixel (`x`, `y`) alone: a camera sample's own value (its filter is
     /// importance-sampled).
+    #[inline(always)]
     pub(super) fn add_pixel(&mut self, x: u32, y: u32, rgb: Vec3) {
         let s = &mut self.sums[(y * self.width + x) as usize];
         for (s, c) in s.iter_mut().zip(rgb.to_array()) {
@@ -75,6 +77,7 @@ impl Splats {
     }
 
     /// Adds `rgb` at raster point (`fx`, `fy`) to the pixels whose filter covers it.
+    #[inline(always)]
     pub(super) fn add(&mut self, fx: f32, fy: f32, rgb: Vec3, box_filter: bool) {
         let mut put = |x: i64, y: i64, w: f32| {
             if x < 0 || y < 0 || x >= i64::from(self.width) || y >= i64::from(self.height) {
@@ -150,6 +153,7 @@ impl<'a> Camera<'a> {
 
     /// The solid-angle density of a camera ray along unit `d` at `time`: 1 / (A cos³θ), the
     /// film's area `A` at distance 1 (a thin lens's rays through one lens point too).
+    #[inline(always)]
     pub(super) fn pdf_dir<const MOTION: bool>(&self, time: f32, d: Vec3) -> f32 {
         let cam = self.frame::<MOTION>(time);
         let cos = d.dot(cam.forward);
@@ -160,6 +164,7 @@ impl<'a> Camera<'a> {
     }
 
     /// The camera's frame at `time`.
+    #[inline(always)]
     fn frame<const MOTION: bool>(&self, time: f32) -> CameraFrame {
         let s = self.scene;
         match &s.camera_path {
@@ -172,6 +177,7 @@ impl<'a> Camera<'a> {
 
     /// Connects `p` to the camera through the lens point drawn from `u`; `None` when `p` is
     /// behind the camera or off the film (beyond the filter's reach of every pixel).
+    #[inline(always)]
     pub(super) fn connect<const MOTION: bool>(
         &self,
         p: Vec3,
@@ -224,6 +230,7 @@ impl<'a> Camera<'a> {
     }
 
     /// Whether nothing lies between `p` (leaving on the side of `n`) and the lens point.
+    #[inline(always)]
     pub(super) fn visible<const MOTION: bool>(
         &self,
         p: Vec3,
@@ -249,6 +256,7 @@ struct CameraVertex<'a, 'b> {
 
 impl CameraVertex<'_, '_> {
     /// Splats the contribution `c` (the transport's channels) of connection `conn`.
+    #[inline(always)]
     pub(super) fn splat<T: Transport<S: ChannelArray<N>>, const N: usize>(
         &mut self,
         c: &C<f32, N>,
@@ -325,26 +333,6 @@ impl<T: Transport<S: ChannelArray<N>>, const N: usize> Vertex<f32, T, N> for Cam
     }
 }
 
-/// Which emitter a light path starts on: what it emits in any direction.
-#[derive(Clone, Copy)]
-pub(super) enum Emitter {
-    /// An area light's (texture-modulated) material.
-    Area {
-        m: crate::components::Material,
-        source: LightSource,
-        /// 1 or 2 (a two-sided emitter).
-        sides: f32,
-    },
-    /// A point or spot light, light index `light`.
-    Point {
-        pl: crate::components::PointLight,
-        light: u32,
-    },
-    /// The environment or the sun, light index `light`: a direction at infinity, the path's
-    /// origin drawn on a disc of the scene's bounding radius facing it.
-    Infinite { light: u32 },
-}
-
 /// A point and direction drawn on an emitter, with the throughput of the path they start.
 pub(super) struct Emission<S> {
     pub(super) p: Vec3,
@@ -358,7 +346,9 @@ pub(super) struct Emission<S> {
     /// the emitter and the point (the emitter seen by the camera); zero at point lights.
     pub(super) le: S,
     pub(super) two_sided: bool,
-    pub(super) emitter: Emitter,
+    /// The environment or the sun: a direction at infinity, the path's origin drawn on a
+    /// disc of the scene's bounding radius facing it.
+    pub(super) at_infinity: bool,
     /// The densities of choosing the emitter and the point (area measure; the choice alone
     /// at a point light), and of the direction `d` (solid angle). At infinity the roles
     /// swap, as the path's vertices see them: `pdf_pos` is the density of the direction
@@ -372,6 +362,7 @@ impl<S: Copy> Emission<S> {
     /// The light path leaving the drawn point along `d` with throughput `beta`: its origin
     /// off the emitter's surface, Russian roulette weighing the throughput against this
     /// first one.
+    #[inline(always)]
     pub(super) fn path<T: Transport<S = S>, const N: usize>(
         &self,
         beta: C<f32, N>,
@@ -403,6 +394,7 @@ impl<S: Copy> Emission<S> {
 
 /// A fresh width-1 path state: the ray `o`, `d` at `time`, throughput `beta`.
 #[allow(clippy::too_many_arguments)]
+#[inline(always)]
 pub(super) fn path_state<T: Transport<S: ChannelArray<N>>, const N: usize>(
     o: Vec3,
     d: Vec3,
@@ -437,6 +429,7 @@ pub(super) fn path_state<T: Transport<S: ChannelArray<N>>, const N: usize>(
 /// Veach's correction of the adjoint BSDF for shading normals (thesis §5.3), after a light
 /// path scattered at `sf` from `wo` into `st.d`. The path tracer's BSDF reflects only light
 /// arriving above the shading normal: reflected light from below it ends the path.
+#[inline(always)]
 pub(super) fn adjoint_correction<T: Transport, const N: usize>(
     st: &mut Paths<f32, T, N>,
     wo: V3<f32>,
@@ -453,48 +446,16 @@ pub(super) fn adjoint_correction<T: Transport, const N: usize>(
     }
 }
 
-impl<S> Emission<S> {
-    /// What the emitter sends along unit `w` from the drawn point (radiance, or a point
-    /// light's intensity) in the transport's channels, and the density with which the
-    /// emission would have drawn `w`; `None` where it sends nothing.
-    pub(super) fn toward<T: Transport<S = S>>(
-        &self,
-        ctx: &Ctx,
-        lam: &T::Lambda,
-        w: Vec3,
-    ) -> Option<(S, f32)> {
-        match self.emitter {
-            Emitter::Area { m, source, sides } => {
-                let rgb = emitted(&m, self.n, w);
-                if rgb == Vec3::ZERO {
-                    return None;
-                }
-                let pdf = self.n.dot(w).abs() / (PI * sides);
-                Some((T::source_radiance(ctx, &source, rgb, lam), pdf))
-            }
-            Emitter::Point { pl, light } => {
-                let scale = pl.falloff(w);
-                let pdf = if pl.cos_cone <= -1.0 {
-                    crate::sampling::uniform_sphere_pdf()
-                } else if w.dot(pl.direction) >= pl.cos_cone {
-                    1.0 / (2.0 * PI * (1.0 - pl.cos_cone))
-                } else {
-                    0.0
-                };
-                if scale <= 0.0 || pdf == 0.0 {
-                    return None;
-                }
-                let source = LightSource::Point { light, scale };
-                Some((
-                    T::source_radiance(ctx, &source, pl.intensity * scale, lam),
-                    pdf,
-                ))
-            }
-            Emitter::Infinite { light } => {
-                let (le, _) = infinite_light::<T>(ctx, light, lam, -w)?;
-                Some((le, ctx.scene.lights.disc_density()))
-            }
-        }
+/// The density with which a point or spot light's emission sends its ray along unit `w`:
+/// uniform over the sphere, or over a spot's cone.
+#[inline(always)]
+pub(super) fn point_emission_pdf(pl: &crate::components::PointLight, w: Vec3) -> f32 {
+    if pl.cos_cone <= -1.0 {
+        crate::sampling::uniform_sphere_pdf()
+    } else if w.dot(pl.direction) >= pl.cos_cone {
+        1.0 / (2.0 * PI * (1.0 - pl.cos_cone))
+    } else {
+        0.0
     }
 }
 
@@ -502,6 +463,7 @@ impl<S> Emission<S> {
 /// its radiance in the transport's channels, and the density with which light sampling (and
 /// a light path's start) draws `wi` from it, with the probability of choosing it. `None`
 /// where it sends nothing.
+#[inline(always)]
 pub(super) fn infinite_light<T: Transport>(
     ctx: &Ctx,
     light: u32,
@@ -541,6 +503,7 @@ pub(super) fn infinite_light<T: Transport>(
 }
 
 /// Calls `f` with each infinite light's index: the environment's, then the sun's.
+#[inline(always)]
 pub(super) fn each_infinite(ctx: &Ctx, mut f: impl FnMut(u32)) {
     let lights = &ctx.scene.lights;
     for i in [lights.environment, lights.sun].into_iter().flatten() {
@@ -551,6 +514,7 @@ pub(super) fn each_infinite(ctx: &Ctx, mut f: impl FnMut(u32)) {
 /// Draws a point on an emitter chosen by power, and a direction from it: cosine-weighted
 /// about an area emitter's normal (either side of a two-sided one), uniform in a spot's cone
 /// or over the sphere of a point light.
+#[inline(always)]
 pub(super) fn emit<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
     ctx: &Ctx,
     lam: &T::Lambda,
@@ -596,10 +560,7 @@ pub(super) fn emit<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTIO
                 beta: beta * (1.0 / (pmf * pdf)),
                 le: T::S::from_array([0.0; N]),
                 two_sided: false,
-                emitter: Emitter::Point {
-                    pl,
-                    light: i as u32,
-                },
+                at_infinity: false,
                 pdf_pos: pmf,
                 pdf_dir: pdf,
             })
@@ -673,7 +634,7 @@ pub(super) fn emit<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTIO
                 beta: le * (PI * sides),
                 le,
                 two_sided,
-                emitter: Emitter::Area { m, source, sides },
+                at_infinity: false,
                 pdf_pos: pmf / area,
                 pdf_dir: local.z / (PI * sides),
             })
@@ -702,7 +663,7 @@ pub(super) fn emit<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTIO
                 beta: le * (1.0 / (pdf * planar)),
                 le: T::S::from_array([0.0; N]),
                 two_sided: false,
-                emitter: Emitter::Infinite { light: i as u32 },
+                at_infinity: true,
                 pdf_pos: pdf,
                 pdf_dir: planar,
             })
@@ -712,6 +673,7 @@ pub(super) fn emit<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTIO
 
 /// The light paths of the samples `work` names of every pixel of `tile`.
 #[allow(clippy::too_many_arguments)]
+#[inline(always)]
 fn trace_tile<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
     ctx: &Ctx,
     camera: &Camera,
@@ -841,9 +803,49 @@ pub(super) fn render<T: Transport<S: ChannelArray<N>>, const N: usize, const MOT
     progress: &dyn Observer,
 ) -> RenderOutput {
     let camera = Camera::new(ctx);
+    let lanes = crate::simd::Lanes::scalar();
     splat_passes(opts, ctx, tiles, progress, |tile, work, splats, stats| {
-        trace_tile::<T, N, MOTION>(ctx, &camera, tile, work, splats, stats)
+        let job = TileJob::<T, N, MOTION> {
+            ctx,
+            camera: &camera,
+            tile,
+            work,
+            splats,
+            stats,
+            transport: PhantomData,
+        };
+        super::run_at(lanes, job)
     })
+}
+
+/// One tile of light tracing, run at width 1 inside the lanes' FMA entry point: the paths'
+/// stages inline there, where `f32::mul_add` is one instruction (outside it, a call into
+/// libm).
+struct TileJob<'a, 'c, 'w, T, const N: usize, const MOTION: bool> {
+    ctx: &'a Ctx<'c>,
+    camera: &'a Camera<'c>,
+    tile: &'a Tile,
+    work: &'a TileWork<'w>,
+    splats: &'a mut Splats,
+    stats: &'a mut RenderStats,
+    transport: PhantomData<T>,
+}
+
+impl<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool> crate::simd::LaneKernel
+    for TileJob<'_, '_, '_, T, N, MOTION>
+{
+    type Output = ();
+    #[inline(always)]
+    fn run<F: crate::simd::Float>(self) {
+        trace_tile::<T, N, MOTION>(
+            self.ctx,
+            self.camera,
+            self.tile,
+            self.work,
+            self.splats,
+            self.stats,
+        )
+    }
 }
 
 /// The pass loop of the estimators that splat: `trace` renders the samples a pass names of
