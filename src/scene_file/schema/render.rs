@@ -180,8 +180,9 @@ pub enum Estimator {
     /// Bidirectional path tracing: a camera and a light subpath per sample, joined in every
     /// way, weighted by multiple importance sampling.
     Bdpt,
-    /// `Bdpt` where a light reaches a specular or dispersive surface (caustic paths) and BDPT
-    /// can take the scene, else `Path` (`prism info` says which, and why).
+    /// `Bdpt` where a light reaches a specular or dispersive surface and the caustics carry
+    /// a measured share of what the camera sees, and BDPT can take the scene, else `Path`
+    /// (`prism info` says which, and why).
     Auto,
 }
 
