@@ -289,6 +289,8 @@ fn auto_chooses_by_the_scene() {
         o.extend_from_slice(extra);
         choose(&load(name, 8, &o))
     };
+    // A scene that names no estimator gets `Auto`.
+    assert_eq!(load("caustics.ron", 8, &[]).settings.kind, Estimator::Auto);
     let (k, why) = pick("cornell.ron", &[]);
     assert_eq!(k, Estimator::Path, "{why}");
     assert!(why.contains("no light reaches"), "{why}");

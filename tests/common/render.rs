@@ -8,17 +8,29 @@ use prism::scene_file::load_str;
 use prism::systems::prepare;
 use std::path::Path;
 
-/// Parses scene text (as if it lived in `scenes/`) and runs the systems.
+/// The estimator these helpers render with unless a scene or an override names one: the
+/// tests that use them check the path tracer's kernels, which `Auto` would replace by BDPT on
+/// scenes with caustics.
+const KIND: &str = "render.integrator.kind";
+
+/// Parses scene text (as if it lived in `scenes/`) and runs the systems, with the path
+/// tracer unless the text names an estimator.
 pub fn scene(text: &str) -> RenderScene {
-    let loaded = load_str(text, Path::new("scenes/test.ron"), &[]).expect("test scene parses");
+    let pin = [(KIND.to_string(), "Path".to_string())];
+    let o: &[(String, String)] = if text.contains("kind:") { &[] } else { &pin };
+    let loaded = load_str(text, Path::new("scenes/test.ron"), o).expect("test scene parses");
     prepare(&loaded, &KdParams::default())
 }
 
+/// Loads a scene file with `overrides`, with the path tracer unless they name an estimator.
 pub fn scene_file(path: &Path, overrides: &[(&str, &str)]) -> RenderScene {
-    let o: Vec<(String, String)> = overrides
+    let mut o: Vec<(String, String)> = overrides
         .iter()
         .map(|(k, v)| (k.to_string(), v.to_string()))
         .collect();
+    if !o.iter().any(|(k, _)| k == KIND) {
+        o.insert(0, (KIND.to_string(), "Path".to_string()));
+    }
     let loaded = prism::scene_file::load(path, &o).expect("scene loads");
     prepare(&loaded, &KdParams::default())
 }

@@ -171,7 +171,6 @@ pub enum LightSampling {
 #[derive(Clone, Copy, Debug, Default, Deserialize, Serialize, PartialEq, Eq)]
 pub enum Estimator {
     /// Unidirectional path tracing from the camera, with the scene's `light_sampling`.
-    #[default]
     Path,
     /// Light tracing: paths start on the emitters, and every vertex whose BSDF has a density
     /// connects to the camera and splats its contribution through the pixel filter. It
@@ -182,7 +181,8 @@ pub enum Estimator {
     Bdpt,
     /// `Bdpt` where a light reaches a specular or dispersive surface and the caustics carry
     /// a measured share of what the camera sees, and BDPT can take the scene, else `Path`
-    /// (`prism info` says which, and why).
+    /// (`prism info` says which, and why). The default.
+    #[default]
     Auto,
 }
 
