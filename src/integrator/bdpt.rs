@@ -1119,6 +1119,9 @@ pub fn choose(scene: &RenderScene) -> (Estimator, String) {
     if scene.settings.target_error.is_some() {
         return (Estimator::Path, "Auto: a target error needs Path".into());
     }
+    if scene.lights.lights.is_empty() {
+        return (Estimator::Path, "Auto: the scene has no light".into());
+    }
     let prims = &scene.prims;
     let caustic = |prim: u32| -> Option<&'static str> {
         let smooth = |a: crate::components::Alpha| a.x.max(a.y) < super::microfacet::SMOOTH_ALPHA;
