@@ -58,7 +58,9 @@ pub(super) fn costs(
     runs: usize,
     size: Option<(u32, u32)>,
 ) -> Result<(), CliError> {
-    let mut set = Vec::new();
+    // The effects are specialised in the path tracer's kernels: measure those, whatever
+    // `Auto` would pick (`converge --vary integrator.kind=...` compares the estimators).
+    let mut set = vec![("render.integrator.kind".to_string(), "Path".to_string())];
     if let Some((w, h)) = size {
         set.push(("render.width".to_string(), w.to_string()));
         set.push(("render.height".to_string(), h.to_string()));
