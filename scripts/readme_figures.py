@@ -12,6 +12,9 @@ for key, path in [("CORNELL", "assets/accuracy/cornell/summary.md"),
                   ("DIAMOND", "assets/accuracy/diamond_bunny/summary.md"),
                   ("PRISM", "assets/accuracy/prism/summary.md"),
                   ("CORNELL_SPECTRAL", "assets/accuracy/cornell_spectral/summary.md"),
+                  ("CAUSTICS_ESTIMATORS", "assets/accuracy/caustics_estimators/summary.md"),
+                  ("PRISM_ESTIMATORS", "assets/accuracy/prism_estimators/summary.md"),
+                  ("DIAMOND_ESTIMATORS", "assets/accuracy/diamond_bunny_estimators/summary.md"),
                   ("COSTS", "assets/accuracy/effect_costs.md")]:
     block = f"<!-- {key} -->\n{table(path)}\n<!-- /{key} -->"
     text = re.sub(rf"<!-- {key} -->.*?<!-- /{key} -->|FIGURES_{key}", lambda _: block, text, flags=re.S)
