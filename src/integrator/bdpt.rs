@@ -104,6 +104,37 @@ struct Vtx<T: Transport, const N: usize> {
     dim: u32,
 }
 
+impl<T: Transport, const N: usize> Vtx<T, N> {
+    /// A vertex at `p` (a direction when `inf`) with normal `ng`, reached with throughput
+    /// `beta` at wavelengths `lam` and generated with area density `fwd`; nothing is known
+    /// of its neighbours or sampled from it yet.
+    #[inline(always)]
+    fn start(
+        p: Vec3,
+        inf: bool,
+        ng: Vec3,
+        beta: C<f32, N>,
+        lam: T::Lanes<f32>,
+        fwd: f32,
+        dim: u32,
+    ) -> Self {
+        Vtx {
+            p,
+            inf,
+            ng,
+            wo: Vec3::ZERO,
+            beta,
+            lam,
+            fwd,
+            rev: 0.0,
+            delta: false,
+            bsdf: None,
+            emits: None,
+            dim,
+        }
+    }
+}
+
 /// The material stage's hook on BDPT subpaths: nothing is connected during the walk; the
 /// BSDF parts of a vertex with a density are kept. `LIGHT` subpaths carry importance.
 struct Keep<const LIGHT: bool> {
@@ -366,39 +397,17 @@ fn walk<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool, co
         if !sf.hit {
             // The camera subpath that escapes meets the environment (s = 0).
             if !LIGHT && scene.lights.has_infinite() {
-                let mut v = Vtx::<T, N> {
-                    p: st.d.lane(0).normalize(),
-                    inf: true,
-                    ng: Vec3::ZERO,
-                    wo: Vec3::ZERO,
-                    beta: st.beta,
-                    lam: st.lam,
-                    fwd: 0.0,
-                    rev: 0.0,
-                    delta: false,
-                    bsdf: None,
-                    emits: None,
-                    dim,
-                };
+                let p = st.d.lane(0).normalize();
+                let mut v = Vtx::<T, N>::start(p, true, Vec3::ZERO, st.beta, st.lam, 0.0, dim);
                 v.fwd = density(pdf_dir, &path[prev], &v);
                 path.push(v);
             }
             break;
         }
         let (p, ng) = (sf.p.lane(0), sf.nf.lane(0));
-        let mut v = Vtx::<T, N> {
-            p,
-            inf: false,
-            ng,
+        let mut v = Vtx {
             wo: -st.d.lane(0),
-            beta: st.beta,
-            lam: st.lam,
-            fwd: 0.0,
-            rev: 0.0,
-            delta: false,
-            bsdf: None,
-            emits: None,
-            dim,
+            ..Vtx::<T, N>::start(p, false, ng, st.beta, st.lam, 0.0, dim)
         };
         v.fwd = density(pdf_dir, &path[prev], &v);
         if sf.class == CLASS_NONE {
@@ -557,20 +566,7 @@ fn sample<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
     let init = T::initial_beta::<f32, N>(&lam);
     let cam = &mut paths.cam;
     cam.clear();
-    cam.push(Vtx {
-        p: o,
-        inf: false,
-        ng: Vec3::ZERO,
-        wo: Vec3::ZERO,
-        beta: init,
-        lam,
-        fwd: 1.0,
-        rev: 0.0,
-        delta: false,
-        bsdf: None,
-        emits: None,
-        dim: 0,
-    });
+    cam.push(Vtx::start(o, false, Vec3::ZERO, init, lam, 1.0, 0));
     let lanes = crate::simd::Lanes::scalar();
     let mut st = path_state::<T, N>(o, d, init, lam, 1.0, time, pixel, index);
     let pdf_cam = camera.pdf_dir::<MOTION>(time, d);
@@ -606,20 +602,8 @@ fn sample<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
         // At infinity the vertex is the direction towards the light; its ray's origin on the
         // disc is not a vertex.
         let inf = e.at_infinity;
-        light.push(Vtx {
-            p: if inf { -e.d } else { e.p },
-            inf,
-            ng: e.n,
-            wo: Vec3::ZERO,
-            beta: init,
-            lam,
-            fwd: e.pdf_pos,
-            rev: 0.0,
-            delta: false,
-            bsdf: None,
-            emits: None,
-            dim,
-        });
+        let p = if inf { -e.d } else { e.p };
+        light.push(Vtx::start(p, inf, e.n, init, lam, e.pdf_pos, dim));
         if max_depth >= 1 {
             let mut st = e.path::<T, N>(init * chan(e.beta), lam, time, pixel, index);
             super::run_at(
@@ -1040,19 +1024,8 @@ fn light_start<T: Transport, const N: usize>(
     use crate::scene::lights::LightSource;
     let lights = &ctx.scene.lights;
     let prims = &ctx.scene.prims;
-    let vertex = |p: Vec3, ng: Vec3, inf: bool, fwd: f32| Vtx::<T, N> {
-        p,
-        inf,
-        ng,
-        wo: Vec3::ZERO,
-        beta: pt.beta,
-        lam: pt.lam,
-        fwd,
-        rev: 0.0,
-        delta: false,
-        bsdf: None,
-        emits: None,
-        dim: 0,
+    let vertex = |p: Vec3, ng: Vec3, inf: bool, fwd: f32| {
+        Vtx::<T, N>::start(p, inf, ng, pt.beta, pt.lam, fwd, 0)
     };
     match (ls.source, ls.point) {
         (LightSource::Area { prim, material, .. }, Some((q, n))) => {
@@ -1276,18 +1249,9 @@ mod tests {
     /// A vertex with densities `fwd`, `rev` (nothing else matters to the weights).
     fn vtx(fwd: f32, rev: f32, delta: bool) -> Vtx<Rgb, 3> {
         Vtx {
-            p: Vec3::ZERO,
-            inf: false,
-            ng: Vec3::ZERO,
-            wo: Vec3::ZERO,
-            beta: C::<f32, 3>::splat(1.0),
-            lam: (),
-            fwd,
             rev,
             delta,
-            bsdf: None,
-            emits: None,
-            dim: 0,
+            ..Vtx::start(Vec3::ZERO, false, Vec3::ZERO, C::splat(1.0), (), fwd, 0)
         }
     }
 
