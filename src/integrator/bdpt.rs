@@ -789,17 +789,8 @@ fn emitter_hit<T: Transport<S: ChannelArray<N>>, const N: usize>(
         return Some((c, pt.lam));
     }
     let pmf = scene.lights.table.pmf(prims.light[prim as usize] as usize);
-    let two_sided = matches!(
-        prims.materials[prims.material[prim as usize] as usize],
-        crate::components::Material::Light {
-            two_sided: true,
-            ..
-        }
-    );
-    let sides = if two_sided { 2.0 } else { 1.0 };
     let prev = &cam[t - 2];
-    let w = pt.wo;
-    let pdf_dir = pt.ng.dot(w).abs() / (PI * sides);
+    let pdf_dir = area_emission_pdf(prims, prims.material[prim as usize], pt.ng, pt.wo);
     let rev = Rev {
         pt: pmf / area,
         pt_minus: density(pdf_dir, pt, prev),
@@ -808,6 +799,24 @@ fn emitter_hit<T: Transport<S: ChannelArray<N>>, const N: usize>(
     };
     let w = mis_weight(cam, &[], 0, t, &rev, false);
     Some((c * w, pt.lam))
+}
+
+/// The density with which an area emitter of `material` sends a light path's first ray
+/// along `w` from a point of normal `n`: cosine-weighted over its one side, or over both.
+#[inline(always)]
+fn area_emission_pdf(
+    prims: &crate::scene::primitives::Primitives,
+    material: u32,
+    n: Vec3,
+    w: Vec3,
+) -> f32 {
+    let sides = match prims.materials[material as usize] {
+        Material::Light {
+            two_sided: true, ..
+        } => 2.0,
+        _ => 1.0,
+    };
+    n.dot(w).abs() / (PI * sides)
 }
 
 /// Strategy (0, t) at infinity: the camera subpath's vertex `t - 1` is a direction towards
@@ -1031,13 +1040,7 @@ fn light_start<T: Transport, const N: usize>(
         (LightSource::Area { prim, material, .. }, Some((q, n))) => {
             let pmf = lights.table.pmf(prims.light[prim as usize] as usize);
             let area = crate::scene::lights::emitter_area(prims, prim);
-            let sides = match prims.materials[material as usize] {
-                Material::Light {
-                    two_sided: true, ..
-                } => 2.0,
-                _ => 1.0,
-            };
-            let pdf_dir = n.dot(ls.wi).abs() / (PI * sides);
+            let pdf_dir = area_emission_pdf(prims, material, n, ls.wi);
             Some((vertex(q, n, false, pmf / area), pdf_dir))
         }
         (LightSource::Point { light, .. }, Some((q, _))) => {
