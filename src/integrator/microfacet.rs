@@ -28,7 +28,7 @@ use super::bsdf::{
 };
 use super::dielectric_energy::Slices;
 use super::ggx_tables::{GGX_E, GGX_E_AVG, GGX_TABLE_SIZE};
-use crate::simd::{Float, Mask, UInt, V3, math};
+use crate::simd::{Float, Mask, TypedKernel, UInt, V3, math};
 use std::f32::consts::TAU;
 
 /// Below this α a rough surface is treated as smooth: a delta lobe, like a mirror. GGX
@@ -377,6 +377,37 @@ pub struct RoughDielectric<F: Float> {
     pub multiscatter: F::Mask,
 }
 
+/// A rough dielectric's out-of-line work, each run inside the entry point of its lanes'
+/// instruction set ([`Float::enter_typed`]), each its own function.
+struct SampleIn<F: Float>(RoughDielectric<F>, V3<F>, [F; 3], Mode);
+struct EvalIn<F: Float>(RoughDielectric<F>, V3<F>, V3<F>, Mode);
+struct PdfIn<F: Float>(RoughDielectric<F>, V3<F>, V3<F>);
+
+impl<F: Float> TypedKernel<F> for SampleIn<F> {
+    type Output = BsdfSample<F, F>;
+    #[inline(always)]
+    fn run(self) -> Self::Output {
+        let [uc, u1, u2] = self.2;
+        self.0.sample_in(self.1, uc, u1, u2, self.3)
+    }
+}
+
+impl<F: Float> TypedKernel<F> for EvalIn<F> {
+    type Output = F;
+    #[inline(always)]
+    fn run(self) -> F {
+        self.0.eval_in(self.1, self.2, self.3)
+    }
+}
+
+impl<F: Float> TypedKernel<F> for PdfIn<F> {
+    type Output = F;
+    #[inline(always)]
+    fn run(self) -> F {
+        self.0.pdf_in(self.1, self.2)
+    }
+}
+
 /// The compensation lobe of a rough dielectric at one (wo, wi) pair: its f (importance
 /// form) and the density of sampling it once chosen.
 struct MsLobe<F> {
@@ -411,7 +442,7 @@ impl<F: Float> RoughDielectric<F> {
     ///
     /// Out of line, as `eval` and `pdf`: inlined into the kernel with the compensation lobe,
     /// the kernel's register allocation took most of a release build; the call is one per
-    /// packet of lanes.
+    /// packet of lanes, into the entry point of the lanes' instruction set.
     #[inline(never)]
     pub fn sample<S: LaneChannels<F>>(
         &self,
@@ -421,6 +452,19 @@ impl<F: Float> RoughDielectric<F> {
         u2: F,
         mode: Mode,
     ) -> BsdfSample<F, S> {
+        let s = F::enter_typed(SampleIn(*self, wo, [uc, u1, u2], mode));
+        BsdfSample {
+            wi: s.wi,
+            weight: S::splat(s.weight),
+            pdf: s.pdf,
+            lobe: s.lobe,
+            eta: s.eta,
+        }
+    }
+
+    /// [`RoughDielectric::sample`] with a colourless weight.
+    #[inline(always)]
+    fn sample_in(&self, wo: V3<F>, uc: F, u1: F, u2: F, mode: Mode) -> BsdfSample<F, F> {
         let (zero, one) = (F::zero(), F::one());
         let ms = self.multiscatter;
         let any_ms = ms.any();
@@ -477,7 +521,7 @@ impl<F: Float> RoughDielectric<F> {
         }
         BsdfSample {
             wi,
-            weight: S::splat(weight),
+            weight,
             pdf,
             lobe: F::U32::select(
                 t,
@@ -548,6 +592,11 @@ impl<F: Float> RoughDielectric<F> {
     /// f(wo, wi) (no cosine): colourless, one value per lane.
     #[inline(never)]
     pub fn eval(&self, wo: V3<F>, wi: V3<F>, mode: Mode) -> F {
+        F::enter_typed(EvalIn(*self, wo, wi, mode))
+    }
+
+    #[inline(always)]
+    fn eval_in(&self, wo: V3<F>, wi: V3<F>, mode: Mode) -> F {
         let sl = self.multiscatter.any().then(|| Slices::new(self.eta));
         self.eval_with(wo, wi, mode, sl.as_ref())
     }
@@ -581,6 +630,11 @@ impl<F: Float> RoughDielectric<F> {
     /// The solid-angle density of [`RoughDielectric::sample`] drawing `wi`.
     #[inline(never)]
     pub fn pdf(&self, wo: V3<F>, wi: V3<F>) -> F {
+        F::enter_typed(PdfIn(*self, wo, wi))
+    }
+
+    #[inline(always)]
+    fn pdf_in(&self, wo: V3<F>, wi: V3<F>) -> F {
         let sl = self.multiscatter.any().then(|| Slices::new(self.eta));
         self.pdf_with(wo, wi, sl.as_ref())
     }

@@ -228,6 +228,11 @@ pub trait Float:
     /// operations there are compiled for the instructions too.
     fn enter<K: LaneKernel>(k: K) -> K::Output;
 
+    /// Runs `k`, whose inputs are already lanes of this type, inside the entry point of its
+    /// instruction set: for a function a kernel keeps out of line (to bound the kernel's
+    /// size). Out of an entry point every intrinsic of the function would be a call.
+    fn enter_typed<K: TypedKernel<Self>>(k: K) -> K::Output;
+
     /// Sum of the lanes, in lane order (for reports and tests, not hot loops).
     #[inline(always)]
     fn reduce_sum(self) -> f32 {
@@ -554,6 +559,15 @@ pub trait LaneKernel {
     type Output;
     /// Mark `#[inline(always)]`: see the module docs.
     fn run<F: Float>(self) -> Self::Output;
+}
+
+/// Work over lanes of the one type `F` that a kernel keeps out of line, run by
+/// [`Float::enter_typed`].
+pub trait TypedKernel<F> {
+    /// What the work returns.
+    type Output;
+    /// Mark `#[inline(always)]`, so the work is compiled inside the entry point.
+    fn run(self) -> Self::Output;
 }
 
 /// Runs `k` instantiated at the lane type of `lanes`, inside an entry point compiled for that

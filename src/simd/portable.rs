@@ -3,7 +3,7 @@
 //! Each operation is written to give exactly the bits of the native x86 instruction it stands
 //! for (see [`Float`]'s semantics), so a portable kernel is a bit-exact oracle of the native one.
 
-use super::{Float, LaneKernel, Mask, UInt};
+use super::{Float, LaneKernel, Mask, TypedKernel, UInt};
 use std::ops::{
     Add, AddAssign, BitAnd, BitAndAssign, BitOr, BitOrAssign, BitXor, Div, DivAssign, Mul,
     MulAssign, Neg, Not, Sub, SubAssign,
@@ -85,6 +85,14 @@ impl Float for f32 {
     #[inline(always)]
     fn enter<K: LaneKernel>(k: K) -> K::Output {
         k.run::<f32>()
+    }
+
+    #[inline(always)]
+    fn enter_typed<K: TypedKernel<Self>>(k: K) -> K::Output {
+        #[cfg(target_arch = "x86_64")]
+        return super::x86::enter_scalar_typed(k);
+        #[cfg(not(target_arch = "x86_64"))]
+        k.run()
     }
 
     #[inline(always)]
@@ -393,6 +401,11 @@ impl<const N: usize> Float for PortableF32<N> {
     #[inline(always)]
     fn enter<K: LaneKernel>(k: K) -> K::Output {
         k.run::<Self>()
+    }
+
+    #[inline(always)]
+    fn enter_typed<K: TypedKernel<Self>>(k: K) -> K::Output {
+        k.run()
     }
 
     #[inline(never)]

@@ -6,7 +6,7 @@
 //! [`super::dispatch`] runs after detecting that instruction set: that is the invariant each
 //! `// SAFETY:` comment refers to ("the type's invariant").
 
-use super::{Float, LaneKernel, Mask, UInt};
+use super::{Float, LaneKernel, Mask, TypedKernel, UInt};
 use std::arch::x86_64::*;
 use std::ops::{
     Add, AddAssign, BitAnd, BitAndAssign, BitOr, BitOrAssign, BitXor, Div, DivAssign, Mul,
@@ -27,6 +27,34 @@ pub(super) fn entry_avx2<K: LaneKernel>(k: K) -> K::Output {
 #[target_feature(enable = "avx512f,avx512bw,avx2,fma")]
 pub(super) fn entry_avx512<K: LaneKernel>(k: K) -> K::Output {
     k.run::<F16>()
+}
+
+/// [`entry_fma`] for work over lanes of one type: see [`Float::enter_typed`].
+#[target_feature(enable = "fma")]
+fn entry_fma_typed<K: TypedKernel<f32>>(k: K) -> K::Output {
+    k.run()
+}
+
+#[target_feature(enable = "avx2,fma")]
+fn entry_avx2_typed<K: TypedKernel<F8>>(k: K) -> K::Output {
+    k.run()
+}
+
+#[target_feature(enable = "avx512f,avx512bw,avx2,fma")]
+fn entry_avx512_typed<K: TypedKernel<F16>>(k: K) -> K::Output {
+    k.run()
+}
+
+/// Width 1's [`Float::enter_typed`]: the FMA entry where the CPU has FMA (its `mul_add` is
+/// then one instruction, not a call into libm; both round once, so the bits are the same).
+#[inline(always)]
+pub(super) fn enter_scalar_typed<K: TypedKernel<f32>>(k: K) -> K::Output {
+    if is_x86_feature_detected!("fma") {
+        // SAFETY: FMA, all the entry enables, was just detected.
+        unsafe { entry_fma_typed(k) }
+    } else {
+        k.run()
+    }
 }
 
 /// Binary operator traits from one intrinsic each.
@@ -191,6 +219,12 @@ impl Float for F8 {
         // SAFETY: the type's invariant: code that names this type runs inside a kernel that
         // `dispatch` started after detecting the instructions `entry_avx2` enables.
         unsafe { entry_avx2(k) }
+    }
+
+    #[inline(always)]
+    fn enter_typed<K: TypedKernel<Self>>(k: K) -> K::Output {
+        // SAFETY: the type's invariant, as for `enter`.
+        unsafe { entry_avx2_typed(k) }
     }
 
     #[inline(always)]
@@ -584,6 +618,12 @@ impl Float for F16 {
         // SAFETY: the type's invariant: code that names this type runs inside a kernel that
         // `dispatch` started after detecting the instructions `entry_avx512` enables.
         unsafe { entry_avx512(k) }
+    }
+
+    #[inline(always)]
+    fn enter_typed<K: TypedKernel<Self>>(k: K) -> K::Output {
+        // SAFETY: the type's invariant, as for `enter`.
+        unsafe { entry_avx512_typed(k) }
     }
 
     #[inline(always)]
