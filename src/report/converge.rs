@@ -541,12 +541,35 @@ fn time_to(points: &[(f64, f64)], target: f64) -> String {
     }
     match fit(points) {
         Some((slope, b)) if slope < -0.05 => {
-            format!(
-                "~{:.3} s (extrapolated)",
-                10f64.powf((target.log10() - b) / slope)
-            )
+            let t = 10f64.powf((target.log10() - b) / slope);
+            if t.is_finite() {
+                format!("~{} (extrapolated)", long_seconds(t))
+            } else {
+                "not reached (error floor)".into()
+            }
         }
         _ => "not reached (error floor)".into(),
+    }
+}
+
+/// A duration that may be far beyond any render: seconds in fixed point up to 10⁴ s, then
+/// in scientific notation with a unit a reader can picture, so a shallow slope's absurd
+/// extrapolation reads as absurd instead of as a wall of digits.
+fn long_seconds(t: f64) -> String {
+    if t < 1e4 {
+        return format!("{t:.3} s");
+    }
+    let (v, unit) = if t < 86_400.0 * 2.0 {
+        (t / 3600.0, "hours")
+    } else if t < 86_400.0 * 365.25 * 2.0 {
+        (t / 86_400.0, "days")
+    } else {
+        (t / (86_400.0 * 365.25), "years")
+    };
+    if v < 1e4 {
+        format!("{t:.2e} s ≈ {v:.0} {unit}")
+    } else {
+        format!("{t:.2e} s ≈ {v:.1e} {unit}")
     }
 }
 
@@ -661,6 +684,18 @@ mod tests {
         let (slope, b) = fit(&pts).unwrap();
         assert!((slope + 1.0).abs() < 1e-12 && (b - 0.5f64.log10()).abs() < 1e-12);
         assert_eq!(time_to(&pts, 0.1), "5.000 s");
+        // Beyond the rungs the fit extrapolates; a shallow slope gives years, said as such.
+        assert_eq!(time_to(&pts, 1e-3), "~500.000 s (extrapolated)");
+        let flat: Vec<(f64, f64)> = (0..6)
+            .map(|k| (2f64.powi(k), 0.5 / 2f64.powf(0.1 * f64::from(k))))
+            .collect();
+        assert_eq!(
+            time_to(&flat, 0.01),
+            "~9.77e16 s ≈ 3.1e9 years (extrapolated)"
+        );
+        assert_eq!(long_seconds(7200.0), "7200.000 s");
+        assert_eq!(long_seconds(36_000.0), "3.60e4 s ≈ 10 hours");
+        assert_eq!(long_seconds(864_000.0), "8.64e5 s ≈ 10 days");
         // Halfway between rungs in log time is halfway in log error on a power law.
         let e = error_at(&pts, 2f64.powf(2.5)).unwrap();
         assert!((e / (0.5 / 2f64.powf(2.5)) - 1.0).abs() < 1e-12);
