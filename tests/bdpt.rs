@@ -304,6 +304,10 @@ fn auto_chooses_by_the_scene() {
     assert_eq!(k, Estimator::Bdpt, "{why}");
     assert!(why.contains("sphere"), "{why}");
     assert!(why.contains("caustics carry"), "{why}");
+    // The caustic beside the ball carries 16 % of the light seen on other surfaces.
+    let (k, why) = pick("glass_ball.ron", &[]);
+    assert_eq!(k, Estimator::Bdpt, "{why}");
+    assert!(why.contains(r#"entity "ball""#), "{why}");
     // A light reaches the glass, but its caustic is a small share of what the camera sees:
     // BDPT loses at equal time there (docs/accuracy.md).
     let (k, why) = pick("glass_bunny.ron", &[]);
