@@ -308,6 +308,15 @@ fn auto_chooses_by_the_scene() {
     let (k, why) = pick("glass_ball.ron", &[]);
     assert_eq!(k, Estimator::Bdpt, "{why}");
     assert!(why.contains(r#"entity "ball""#), "{why}");
+    // The sun shines on a glass sphere that no probe from the sun's scene-wide disc meets.
+    for name in ["daylight.ron", "sunset.ron"] {
+        let (k, why) = pick(name, &[]);
+        assert_eq!(k, Estimator::Bdpt, "{name}: {why}");
+        assert!(
+            why.contains(r#"entity "glass": smooth Dielectric; the sun shines on it"#),
+            "{name}: {why}"
+        );
+    }
     // A light reaches the glass, but its caustic is a small share of what the camera sees:
     // BDPT loses at equal time there (docs/accuracy.md).
     let (k, why) = pick("glass_bunny.ron", &[]);

@@ -1082,8 +1082,10 @@ const PROBE_RAYS: u32 = 16384;
 /// light reaches a specular or dispersive surface (a smooth dielectric, a dispersive one of
 /// any roughness, a mirror or a smooth conductor: the first vertex of caustic paths), the
 /// caustics carry at least 3 % of the light the camera sees on other surfaces, and BDPT
-/// can take the scene; otherwise, and for a target error, the path tracer. Both are found by 16,384 emission rays, drawn as light paths start (lights by
-/// power) and followed through specular chains. Other kinds resolve to themselves.
+/// can take the scene, or where the sun shines on such a surface; otherwise, and for a
+/// target error, the path tracer. Reach and share are found by 16,384 emission rays, drawn as
+/// light paths start (lights by power) and followed through specular chains. Other kinds
+/// resolve to themselves.
 pub fn choose(scene: &RenderScene) -> (Estimator, String) {
     let kind = scene.settings.kind;
     if kind != Estimator::Auto {
@@ -1191,6 +1193,29 @@ pub fn choose(scene: &RenderScene) -> (Estimator, String) {
             break;
         }
     }
+    // The sun is half a degree wide and very bright: its caustics are paths a camera subpath
+    // completes only by chance, each worth thousands of times a pixel's value, and BDPT's MIS
+    // weighs them down (docs/accuracy.md, the sky scenes). The probes above start on a disc
+    // as wide as the scene, which a small specular object under a sky may never meet, so
+    // each specular primitive is asked directly whether the sun shines on it.
+    if let Some(sky) = scene.lights.sky.as_deref()
+        && scene
+            .lights
+            .lights
+            .iter()
+            .any(|l| matches!(l, LightKind::Sun))
+        && let Some(p) = (0..prims.material.len() as u32)
+            .find(|&p| caustic(p).is_some() && sun_reaches(scene, p, sky.sun_direction(), time))
+    {
+        return (
+            Estimator::Bdpt,
+            format!(
+                "Auto: entity {}: {}; the sun shines on it",
+                crate::components::quoted(&prims.names[p as usize]),
+                caustic(p).unwrap_or_default()
+            ),
+        );
+    }
     // The specular surface the lights reach most, and the light that reaches it most.
     let Some(&(prim, light, _)) = hits.iter().max_by_key(|h| (h.2, std::cmp::Reverse(h.0))) else {
         return (
@@ -1232,6 +1257,22 @@ pub fn choose(scene: &RenderScene) -> (Estimator, String) {
              on other surfaces)"
         ),
     )
+}
+
+/// Whether the sun, towards `dir`, shines on primitive `prim`: any of five rays towards it
+/// from the side of the primitive's bounding sphere that faces it (its centre and four
+/// points halfway out) is clear.
+fn sun_reaches(scene: &RenderScene, prim: u32, dir: Vec3, time: f32) -> bool {
+    let b = scene.prims.bounds_of(prim);
+    let (c, r) = ((b.min + b.max) * 0.5, (b.max - b.min).length() * 0.5);
+    if !(c.is_finite() && r.is_finite()) {
+        return false;
+    }
+    let (a, t) = dir.any_orthonormal_pair();
+    [Vec3::ZERO, a, -a, t, -t].iter().any(|&o| {
+        let from = c + dir * (r * 1.001) + o * (0.5 * r);
+        !scene.occluded::<false>(&Ray::new(from, dir), f32::INFINITY, time)
+    })
 }
 
 /// The caustics' share of the light the camera sees on non-specular surfaces above which
