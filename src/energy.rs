@@ -33,16 +33,23 @@ pub fn ggx_albedo_with(
     let wo = [(1.0 - mu * mu).sqrt(), 0.0, mu];
     let a2 = alpha * alpha;
     let s = |w: [f64; 3]| (a2 * (w[0] * w[0] + w[1] * w[1]) + w[2] * w[2]).sqrt();
+    let s_wo = s(wo);
+    // wo lies in the xz plane: the integrand is even in φ, so half the circle, twice.
+    let phis: Vec<(f64, f64)> = (0..np)
+        .map(|j| {
+            let phi = (j as f64 + 0.5) / np as f64 * PI;
+            (phi.cos(), phi.sin())
+        })
+        .collect();
+    let dphi = 2.0 * PI / np as f64;
     let mut e = 0.0;
     for i in 0..nt {
         let t = (i as f64 + 0.5) / nt as f64;
         let cos = 1.0 - t * t;
         let sin = (1.0 - cos * cos).max(0.0).sqrt();
         let dcos = 2.0 * t / nt as f64;
-        // wo lies in the xz plane: the integrand is even in φ, so half the circle, twice.
-        for j in 0..np {
-            let phi = (j as f64 + 0.5) / np as f64 * PI;
-            let h = [sin * phi.cos(), sin * phi.sin(), cos];
+        for &(pc, ps) in &phis {
+            let h = [sin * pc, sin * ps, cos];
             let oh = wo[0] * h[0] + wo[2] * h[2];
             if oh <= 0.0 {
                 continue;
@@ -57,8 +64,8 @@ pub fn ggx_albedo_with(
             }
             let q = (h[0] * h[0] + h[1] * h[1]) / a2 + h[2] * h[2];
             let d = 1.0 / (PI * a2 * q * q);
-            let g2 = 2.0 * wo[2] * wi[2] / (s(wo) * wi[2] + s(wi) * wo[2]);
-            e += fresnel(oh) * d * g2 * oh / mu * dcos * (2.0 * PI / np as f64);
+            let g2 = 2.0 * wo[2] * wi[2] / (s_wo * wi[2] + s(wi) * wo[2]);
+            e += fresnel(oh) * d * g2 * oh / mu * dcos * dphi;
         }
     }
     e
@@ -110,20 +117,17 @@ pub fn coat_table(eta: f32) -> Vec<f32> {
     let n = TABLE_SIZE;
     let last = (n - 1) as f64;
     let eta = f64::from(eta);
-    let rows: Vec<Vec<f64>> = (0..n)
+    // One work item per (α, μ) node: the rows' costs differ, the nodes' hardly.
+    let nodes: Vec<f64> = (0..n * n)
         .into_par_iter()
-        .map(|j| {
-            let alpha = j as f64 / last;
-            (0..n)
-                .map(|i| {
-                    let mu = i as f64 / last;
-                    // A grid half as fine as the committed GGX tables': E enters the albedo
-                    // of a white plastic only as E_true − E_table (see the module's notes).
-                    ggx_albedo_with(mu, alpha, |c| fresnel_f64(c, eta), (512, 128)).min(1.0)
-                })
-                .collect()
+        .map(|k| {
+            let (alpha, mu) = ((k / n) as f64 / last, (k % n) as f64 / last);
+            // A grid half as fine as the committed GGX tables': E enters the albedo
+            // of a white plastic only as E_true − E_table (see the module's notes).
+            ggx_albedo_with(mu, alpha, |c| fresnel_f64(c, eta), (512, 128)).min(1.0)
         })
         .collect();
+    let rows: Vec<&[f64]> = nodes.chunks(n).collect();
     let mut t = Vec::with_capacity(COAT_TABLE_LEN);
     for row in &rows {
         t.extend(row.iter().map(|&e| e as f32));
