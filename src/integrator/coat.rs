@@ -79,11 +79,13 @@ impl<F: Float, const N: usize> Plastic<'_, F, N> {
             self.base.wrapping_add(F::U32::splat(F_IN as u32)),
         );
         let one = F::one();
-        Chan(
-            self.albedo
-                .0
-                .map(|r| r * (one - f_in) / (one - r * f_in).max(F::splat(1e-6))),
-        )
+        // A loop, not `map`: the closure of a `map` that is not inlined is compiled without
+        // the entry point's target features, and every lane operation in it becomes a call.
+        let mut rho = self.albedo.0;
+        for r in &mut rho {
+            *r = *r * (one - f_in) / (one - *r * f_in).max(F::splat(1e-6));
+        }
+        Chan(rho)
     }
 
     /// The probability of sampling the coat's lobe from `wo`: its share of the albedo,

@@ -170,10 +170,10 @@ impl Sampler {
                 unit::<F>(sobol::owen_sobol_x(i, Self::seed32(h, 2)))
             }
             // PCG's 64-bit state has no lane form: one lane at a time.
-            SamplerKind::Independent => F::from_fn(|k| {
-                let mut rng = self.pcg(pixel.lane(k), index.lane(k), dim.lane(k));
-                u32_to_unit_f32(rng.next_u32())
-            }),
+            SamplerKind::Independent => {
+                let (p, ix, d) = lane_keys::<F>(pixel, index, dim);
+                F::from_fn(|k| u32_to_unit_f32(self.pcg(p[k], ix[k], d[k]).next_u32()))
+            }
         }
     }
 
@@ -188,9 +188,10 @@ impl Sampler {
                 (unit::<F>(x), unit::<F>(y))
             }
             SamplerKind::Independent => {
+                let (p, ix, d) = lane_keys::<F>(pixel, index, dim);
                 let mut ys = [0.0f32; 16];
                 let x = F::from_fn(|k| {
-                    let mut rng = self.pcg(pixel.lane(k), index.lane(k), dim.lane(k));
+                    let mut rng = self.pcg(p[k], ix[k], d[k]);
                     let x = u32_to_unit_f32(rng.next_u32());
                     ys[k] = u32_to_unit_f32(rng.next_u32());
                     x
@@ -199,4 +200,20 @@ impl Sampler {
             }
         }
     }
+}
+
+/// The lanes of three keys as arrays, extracted here rather than inside a `from_fn` closure:
+/// a closure that is not inlined loses the kernel's target features, and each lane
+/// extraction in it becomes a call.
+#[inline(always)]
+fn lane_keys<F: Float>(
+    pixel: F::U32,
+    index: F::U32,
+    dim: F::U32,
+) -> ([u32; 16], [u32; 16], [u32; 16]) {
+    let (mut p, mut ix, mut d) = ([0u32; 16], [0u32; 16], [0u32; 16]);
+    for k in 0..F::WIDTH {
+        (p[k], ix[k], d[k]) = (pixel.lane(k), index.lane(k), dim.lane(k));
+    }
+    (p, ix, d)
 }

@@ -202,11 +202,6 @@ impl F8 {
         unsafe { _mm256_storeu_ps(a.as_mut_ptr(), self.0) };
         a
     }
-    #[inline(always)]
-    fn bits_op(self, f: impl Fn(__m256i) -> __m256i) -> Self {
-        // SAFETY: the type's invariant.
-        F8(unsafe { _mm256_castsi256_ps(f(_mm256_castps_si256(self.0))) })
-    }
 }
 
 impl Float for F8 {
@@ -311,8 +306,15 @@ impl Float for F8 {
     }
     #[inline(always)]
     fn abs(self) -> Self {
+        // No closure here: one that is not inlined is compiled without the entry point's
+        // target features, and its intrinsics become calls.
         // SAFETY: the type's invariant.
-        self.bits_op(|b| unsafe { _mm256_and_si256(b, _mm256_set1_epi32(0x7fff_ffff)) })
+        F8(unsafe {
+            _mm256_castsi256_ps(_mm256_and_si256(
+                _mm256_castps_si256(self.0),
+                _mm256_set1_epi32(0x7fff_ffff),
+            ))
+        })
     }
     #[inline(always)]
     fn copysign(self, sign: Self) -> Self {
@@ -549,8 +551,15 @@ impl Neg for F16 {
     type Output = Self;
     #[inline(always)]
     fn neg(self) -> Self {
+        // Bitwise float operations through the integer forms (`_mm512_xor_ps` needs
+        // AVX-512DQ), written out: a closure that is not inlined loses the target features.
         // SAFETY: the type's invariant.
-        self.bits_op(|b| unsafe { _mm512_xor_si512(b, _mm512_set1_epi32(i32::MIN)) })
+        F16(unsafe {
+            _mm512_castsi512_ps(_mm512_xor_si512(
+                _mm512_castps_si512(self.0),
+                _mm512_set1_epi32(i32::MIN),
+            ))
+        })
     }
 }
 
@@ -598,13 +607,6 @@ impl F16 {
         // SAFETY: the type's invariant; `a` has room for 16 f32.
         unsafe { _mm512_storeu_ps(a.as_mut_ptr(), self.0) };
         a
-    }
-    #[inline(always)]
-    fn bits_op(self, f: impl Fn(__m512i) -> __m512i) -> Self {
-        // Bitwise float operations through the integer forms: `_mm512_and_ps` and
-        // `_mm512_xor_ps` need AVX-512DQ, the integer ones only AVX-512F.
-        // SAFETY: the type's invariant.
-        F16(unsafe { _mm512_castsi512_ps(f(_mm512_castps_si512(self.0))) })
     }
 }
 
@@ -710,8 +712,14 @@ impl Float for F16 {
     }
     #[inline(always)]
     fn abs(self) -> Self {
+        // As in `neg`: integer forms (`_mm512_and_ps` needs AVX-512DQ), no closure.
         // SAFETY: the type's invariant.
-        self.bits_op(|b| unsafe { _mm512_and_si512(b, _mm512_set1_epi32(0x7fff_ffff)) })
+        F16(unsafe {
+            _mm512_castsi512_ps(_mm512_and_si512(
+                _mm512_castps_si512(self.0),
+                _mm512_set1_epi32(0x7fff_ffff),
+            ))
+        })
     }
     #[inline(always)]
     fn copysign(self, sign: Self) -> Self {
