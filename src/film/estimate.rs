@@ -9,44 +9,96 @@
 //! an Owen-scrambled Sobol sequence puts its even and odd samples in complementary halves of
 //! every stratum, so `a − b` would measure the pixel's structure, not its noise. Each
 //! channel's estimate is divided by `r² + 0.01`, the denominator of `prism compare`'s relMSE,
-//! with `r²` estimated without bias by `a·b` (`E[ab] = E[a]E[b]` for independent halves; it is
-//! `x² − (a − b)²/4`), clamped at 0. With `x²` instead, a pixel whose one half drew a rare
-//! bright sample would never count for more than about 1, where its true error (against a dark
-//! reference) is far larger: that underestimated the Cornell box's error by 9 % at 32 spp.
+//! with `r²` estimated from two sources. The pixel's own `a·b` is unbiased (`E[ab] = E[a]E[b]`
+//! for independent halves; it is `x² − (a − b)²/4`), clamped at 0, but with few samples it
+//! is often near 0 (a half that drew only dark samples), and the estimate then divides by
+//! 0.01: 12× the true error of the Cornell box at 2 spp, 1.45× at 8. The mean `a·b` of the
+//! eight neighbours is steady, being drawn from other samples, but wrong at an edge, above
+//! all next to a light seen directly; capped by the pixel's own `x²` (which exceeds its `r²`
+//! only by its variance) it stays near the pixel's brightness. The two are blended by the
+//! pixel's samples per half `h`: `r² ≈ w·ab + (1 − w)·min(N, x²)`, `w = h / (h + 4)`, so
+//! the neighbours weigh little once a pixel has a few dozen samples. Measured against the
+//! true error over independent renders (0.6 to 1.25× at 2 spp, within 0.84–1.08× from 8 spp
+//! on the Cornell box, the textured scene and a haze; docs/accuracy.md). With `x²` alone, a
+//! pixel whose one half drew a rare bright sample would never count for more than about 1,
+//! where its true error (against a dark reference) is far larger.
 //! The image's estimated relMSE is the mean over pixels and channels, as `compare` averages.
 
 use super::compare::RELMSE_EPSILON;
 
-/// The estimated relMSE of one pixel's mean (averaged over its channels) from the sums of all
-/// its `n` samples and of half B's `n / 2`. `n` must be even; below 2 nothing is known and
-/// the estimate is infinite.
+/// A pixel's half means `(a, b)` per channel from the sums of all its `n` samples and of
+/// half B's `n / 2`.
 #[inline]
-pub fn pixel_error(sum: [f64; 3], half: [f64; 3], n: u32) -> f64 {
+fn halves(sum: [f64; 3], half: [f64; 3], n: u32) -> [(f64, f64); 3] {
+    let h = f64::from(n / 2);
+    std::array::from_fn(|c| ((sum[c] - half[c]) / h, half[c] / h))
+}
+
+/// How much a pixel with `h` samples per half trusts its own `a·b` as `r²` over its
+/// neighbours' (see the module's notes).
+const OWN_WEIGHT_HALF_SAMPLES: f64 = 4.0;
+
+/// The estimated relMSE of one pixel's mean (averaged over its channels) from the sums of all
+/// its `n` samples and of half B's `n / 2`, and `near`, the mean `max(a·b, 0)` of its
+/// neighbours per channel (`None`: the pixel's own is used). `n` must be even; below 2
+/// nothing is known and the estimate is infinite.
+#[inline]
+pub fn pixel_error(sum: [f64; 3], half: [f64; 3], n: u32, near: Option<[f64; 3]>) -> f64 {
     if n < 2 {
         return f64::INFINITY;
     }
     let h = f64::from(n / 2);
+    let w = h / (h + OWN_WEIGHT_HALF_SAMPLES);
     let mut e = 0.0;
-    for c in 0..3 {
-        let b = half[c] / h;
-        let a = (sum[c] - half[c]) / h;
-        e += 0.25 * (a - b) * (a - b) / ((a * b).max(0.0) + RELMSE_EPSILON);
+    for (c, (a, b)) in halves(sum, half, n).into_iter().enumerate() {
+        let ab = (a * b).max(0.0);
+        let x = 0.5 * (a + b);
+        let r2 = match near {
+            Some(nb) => w * ab + (1.0 - w) * nb[c].min(x * x),
+            None => ab,
+        };
+        e += 0.25 * (a - b) * (a - b) / (r2 + RELMSE_EPSILON);
     }
     e / 3.0
 }
 
-/// Per-pixel estimated relMSE of a film with halves, each pixel with its own sample count
-/// ([`pixel_error`] of each).
-///
-/// The median of `a·b` over the 3×3 neighbourhood was tried as `r²`, to keep a rare bright
-/// sample in one half from raising the pixel's own `a·b` with its variance: below 32 samples
-/// per pixel it overestimated the Cornell box's error 2.9× (the median of so few noisy
-/// products lies well below their mean), so the pixel's own `a·b` stays.
-pub fn pixel_errors(sums: &[[f64; 3]], half: &[[f64; 3]], counts: &[u32]) -> Vec<f64> {
-    sums.iter()
-        .zip(half)
-        .zip(counts)
-        .map(|((s, h), &n)| pixel_error(*s, *h, n))
+/// Per-pixel estimated relMSE of a `width` × `height` film with halves, each pixel with its
+/// own sample count: [`pixel_error`] of each, with the mean `max(a·b, 0)` of its (up to
+/// eight) neighbours that have samples.
+pub fn pixel_errors(
+    sums: &[[f64; 3]],
+    half: &[[f64; 3]],
+    counts: &[u32],
+    width: u32,
+    height: u32,
+) -> Vec<f64> {
+    let (w, h) = (width as usize, height as usize);
+    debug_assert_eq!(sums.len(), w * h);
+    let ab: Vec<Option<[f64; 3]>> = (0..sums.len())
+        .map(|p| {
+            (counts[p] >= 2)
+                .then(|| halves(sums[p], half[p], counts[p]).map(|(a, b)| (a * b).max(0.0)))
+        })
+        .collect();
+    (0..sums.len())
+        .map(|p| {
+            let (x, y) = (p % w.max(1), p / w.max(1));
+            let (mut s, mut k) = ([0.0; 3], 0.0);
+            for yy in y.saturating_sub(1)..(y + 2).min(h) {
+                for xx in x.saturating_sub(1)..(x + 2).min(w) {
+                    if (xx, yy) != (x, y)
+                        && let Some(v) = ab[yy * w + xx]
+                    {
+                        for c in 0..3 {
+                            s[c] += v[c];
+                        }
+                        k += 1.0;
+                    }
+                }
+            }
+            let near = (k > 0.0).then(|| s.map(|v| v / k));
+            pixel_error(sums[p], half[p], counts[p], near)
+        })
         .collect()
 }
 
@@ -200,14 +252,33 @@ mod tests {
 
     #[test]
     fn equal_halves_have_no_error_and_unequal_ones_the_formula() {
-        assert_eq!(pixel_error([4.0; 3], [2.0; 3], 4), 0.0);
+        assert_eq!(pixel_error([4.0; 3], [2.0; 3], 4, None), 0.0);
         // a = 1, b = 3 per channel: Var = 1, r² ≈ ab = 3, relMSE = 1 / 3.01.
-        let e = pixel_error([8.0; 3], [6.0; 3], 4);
+        let e = pixel_error([8.0; 3], [6.0; 3], 4, None);
         assert!((e - 1.0 / 3.01).abs() < 1e-12);
         // One bright half over a dark pixel: r² ≈ 0, the error is the variance over 0.01.
-        let e = pixel_error([200.0; 3], [0.0; 3], 4);
+        let e = pixel_error([200.0; 3], [0.0; 3], 4, None);
         assert!((e - 100.0f64.powi(2) / 4.0 / 0.01).abs() < 1e-6, "{e}");
-        assert!(pixel_error([1.0; 3], [0.0; 3], 1).is_infinite());
+        assert!(pixel_error([1.0; 3], [0.0; 3], 1, None).is_infinite());
+    }
+
+    #[test]
+    fn a_dark_half_borrows_its_neighbours_brightness() {
+        // 3×3 pixels of one sample per half: a = b = 1 around, a = 2 and b = 0 in the middle.
+        let mut sums = vec![[2.0; 3]; 9];
+        let mut half = vec![[1.0; 3]; 9];
+        (sums[4], half[4]) = ([2.0; 3], [0.0; 3]);
+        let e = pixel_errors(&sums, &half, &[2; 9], 3, 3);
+        assert!(e.iter().enumerate().all(|(p, &e)| p == 4 || e == 0.0));
+        // Own a·b = 0, neighbours' 1, x² = 1; w = 1/5: r² = 0.8, Var = 1.
+        assert!((e[4] - 1.0 / 0.81).abs() < 1e-12, "{}", e[4]);
+        // The pixel alone divides by 0.01.
+        assert!((pixel_error(sums[4], half[4], 2, None) - 100.0).abs() < 1e-9);
+        // With many samples its own a·b dominates: h = 96, w = 0.96, r² = 0.04.
+        let mut counts = [2; 9];
+        (counts[4], sums[4]) = (192, [192.0; 3]);
+        let e = pixel_errors(&sums, &half, &counts, 3, 3);
+        assert!((e[4] - 1.0 / 0.05).abs() < 1e-9, "{}", e[4]);
     }
 
     #[test]
