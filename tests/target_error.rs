@@ -218,6 +218,28 @@ fn adaptive_renders_are_the_same_on_one_or_two_threads() {
 }
 
 /// `spp` caps every pixel, and the cap is always reached in even steps (equal halves).
+/// A target error set through the library's options, on a scene for which `Auto` would take
+/// BDPT (whose splats keep no halves), is path traced to the target like any other.
+#[test]
+fn a_target_error_takes_the_path_tracer_under_auto() {
+    let rs = scene_file(
+        Path::new("scenes/caustics.ron"),
+        &[
+            ("render.integrator.kind", "Auto"),
+            ("render.width", "32"),
+            ("render.height", "32"),
+        ],
+    );
+    assert_eq!(
+        prism::integrator::bdpt::choose(&rs).0,
+        prism::scene_file::schema::Estimator::Bdpt
+    );
+    let out = adaptive(&rs, 0.05, 256);
+    let est = out.estimate.unwrap();
+    assert!(est > 0.0 && est <= 0.05, "estimated {est}");
+    assert!(!out.counts.is_empty() && out.mean_spp() < 256.0);
+}
+
 #[test]
 fn the_sample_count_caps_every_pixel() {
     let rs = load("cornell.ron", 24, 4);

@@ -422,9 +422,14 @@ fn render_with<
     let mut ctx = Ctx::new(scene, scene.effects.has(Effect::Lens)).with_spectral(&spectral);
     ctx.monochromatic = opts.monochromatic;
     // A scene the splatting estimators cannot take yet is path traced (the CLI refuses it
-    // first).
+    // first), and so is a render to a target error, set here or in the scene: only the path
+    // tracer's passes keep the two halves the estimate needs.
     let (kind, _) = bdpt::choose(scene);
-    if kind != Estimator::Path && !MEDIA && light_tracer::unsupported(scene).is_none() {
+    if kind != Estimator::Path
+        && opts.target_error.is_none()
+        && !MEDIA
+        && light_tracer::unsupported(scene).is_none()
+    {
         let tiles = tiles(scene.settings.width, scene.settings.height);
         if kind == Estimator::LightTracing {
             return light_tracer::render::<T, N, MOTION>(&ctx, opts, &tiles, progress);
