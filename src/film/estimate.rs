@@ -18,7 +18,7 @@
 //! only by its variance) it stays near the pixel's brightness. The two are blended by the
 //! pixel's samples per half `h`: `r² ≈ w·ab + (1 − w)·min(N, x²)`, `w = h / (h + 4)`, so
 //! the neighbours weigh little once a pixel has a few dozen samples. Measured against the
-//! true error over independent renders (0.6 to 1.25× at 2 spp, within 0.84–1.08× from 8 spp
+//! true error over independent renders (0.77 to 1.25× at 2 spp, within 0.84–1.08× from 8 spp
 //! on the Cornell box, the textured scene and a haze; docs/accuracy.md). With `x²` alone, a
 //! pixel whose one half drew a rare bright sample would never count for more than about 1,
 //! where its true error (against a dark reference) is far larger.
