@@ -1,14 +1,15 @@
 //! Bidirectional path tracing against the path tracer and light tracing, pixel by pixel: the
 //! same image within noise on scenes of every emitter kind, a thin lens, motion, textures with
-//! normal maps and glossy materials; on caustic scenes (a glass ball, the smooth-shaded glass
-//! bunny, a dispersive ball) against light tracing where both see the same paths; each
+//! normal maps, glossy materials and media; on caustic scenes (a glass ball, the smooth-shaded
+//! glass bunny, a dispersive ball) against light tracing where both see the same paths; each
 //! strategy alone converging to the same image; the same bits on any thread count.
 
 mod common;
 
 use assert_cmd::cargo::CommandCargoExt;
 use common::estimators::{
-    GLOSSY, GREY_SKY, LAMPS, NO_SKY, OUTDOOR, STUDIO_MAP, Side, THIN_LENS, agree, batch, load, side,
+    FOG_BOX, GLOSSY, GREY_SKY, LAMPS, NO_SKY, OUTDOOR, STUDIO_MAP, Side, THIN_LENS, agree, batch,
+    load, rough_fog_box, side,
 };
 use prism::components::Material;
 use prism::geometry::Ray;
@@ -221,28 +222,32 @@ fn same_image_on_one_and_two_threads() {
     assert_eq!(on(1).pixels, on(2).pixels);
 }
 
-/// Media are refused with one clear line naming the estimator.
+/// Media: vertices in fog and in a glass ball's medium, lights outside and inside the fog;
+/// the ball smooth, then rough (connections through it into its medium).
 #[test]
-fn media_are_refused() {
-    let dir = tempfile::tempdir().unwrap();
-    let out = Command::cargo_bin("prism")
-        .unwrap()
-        .args([
-            "render",
-            "scenes/fog_lamps.ron",
-            "--quiet",
-            "--spp",
-            "1",
-            "-o",
-        ])
-        .arg(dir.path().join("x.png"))
-        .args(["--set", "render.integrator.kind=Bdpt"])
-        .output()
-        .unwrap();
-    assert!(!out.status.success());
-    let err = String::from_utf8(out.stderr).unwrap();
-    assert_eq!(err.lines().count(), 1, "{err}");
-    assert!(err.contains("Bdpt") && err.contains("media"), "{err}");
+fn media_with_lights_outside_and_inside() {
+    against_path("fog box", FOG_BOX, 24, &[NO_SKY], 32, 16);
+    against_path(
+        "fog box, rough glass",
+        &rough_fog_box(),
+        24,
+        &[NO_SKY],
+        32,
+        16,
+    );
+}
+
+/// Media around the camera too: the shipped lamps in fog (area emitters inside the haze).
+#[test]
+fn media_around_the_camera() {
+    against_path(
+        "fog lamps",
+        "fog_lamps.ron",
+        24,
+        &[("render.max_depth", "6")],
+        32,
+        16,
+    );
 }
 
 /// Every shipped scene under every estimator, at 12² and 2 samples per pixel: no NaN or
@@ -277,9 +282,9 @@ fn no_nan_and_no_dropped_sample_on_shipped_scenes() {
     }
 }
 
-/// `Auto` takes BDPT where a light reaches a specular or dispersive surface, its caustics
-/// carry a measured share of what the camera sees, and BDPT can render the scene; the path
-/// tracer elsewhere; `prism info` says which and why.
+/// `Auto` takes BDPT where a light reaches a specular or dispersive surface and its caustics
+/// carry a measured share of what the camera sees; the path tracer elsewhere; `prism info`
+/// says which and why.
 #[test]
 fn auto_chooses_by_the_scene() {
     use prism::integrator::bdpt::choose;
@@ -325,9 +330,10 @@ fn auto_chooses_by_the_scene() {
     let (k, why) = pick("caustics.ron", &[("render.target_error", "0.05")]);
     assert_eq!(k, Estimator::Path, "{why}");
     assert!(why.contains("target error"), "{why}");
+    // Fog: the probes cross its boundary, and no light there reaches a specular surface.
     let (k, why) = pick("fog_lamps.ron", &[]);
     assert_eq!(k, Estimator::Path, "{why}");
-    assert!(why.contains("media"), "{why}");
+    assert!(why.contains("no light reaches"), "{why}");
     let out = Command::cargo_bin("prism")
         .unwrap()
         .args([

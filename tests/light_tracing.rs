@@ -1,12 +1,13 @@
 //! Light tracing against the path tracer: the same image within noise, pixel by pixel, on
 //! scenes of every emitter kind, a thin lens, motion, textures with normal maps and glossy
-//! materials; the same bits on any thread count; clear refusals of what it does not handle.
+//! materials, media; the same bits on any thread count; a clear refusal of a target error.
 
 mod common;
 
 use assert_cmd::cargo::CommandCargoExt;
 use common::estimators::{
-    GLOSSY, GREY_SKY, LAMPS, NO_SKY, OUTDOOR, STUDIO_MAP, THIN_LENS, agree, batch, load, side,
+    GLOSSY, GREY_SKY, LAMPS, NO_SKY, OUTDOOR, STUDIO_MAP, THIN_LENS, agree, batch, load,
+    rough_fog_box, side,
 };
 use std::process::Command;
 
@@ -95,9 +96,18 @@ fn same_image_on_one_and_two_threads() {
     assert_eq!(on(1).pixels, on(2).pixels);
 }
 
-/// Media and a target error are refused with one clear line.
+/// Media: light paths scatter in fog and in a rough glass ball's medium and connect to the
+/// camera through both, from lights outside and inside the fog. (With the camera inside a
+/// scattering medium, points that scatter next to the lens splat ∝ 1/r²: light tracing's
+/// variance is unbounded there, and a z-test of its batches meaningless.)
 #[test]
-fn unsupported_scenes_are_refused() {
+fn media() {
+    agreement("fog box", &rough_fog_box(), 32, &[NO_SKY], 32, 32);
+}
+
+/// A target error is refused with one clear line.
+#[test]
+fn a_target_error_is_refused() {
     let dir = tempfile::tempdir().unwrap();
     let run = |scene: &str, extra: &[&str]| {
         let out = Command::cargo_bin("prism")
@@ -113,8 +123,6 @@ fn unsupported_scenes_are_refused() {
         assert_eq!(err.lines().count(), 1, "{err}");
         err
     };
-    let e = run("scenes/fog_lamps.ron", &[]);
-    assert!(e.contains("LightTracing") && e.contains("media"), "{e}");
     let e = run(
         "scenes/cornell.ron",
         &["--target-error", "0.05", "--set", "render.width=8"],

@@ -29,18 +29,11 @@ pub(super) fn prepare(
     let mut rs = systems::prepare_frame(scene, &KdParams::default(), frame);
     force_effects(&mut rs, force)?;
     let kind = rs.settings.kind;
-    // `Auto` falls back to the path tracer where BDPT cannot render the scene.
-    if kind != Estimator::Path && kind != Estimator::Auto {
-        if let Some(why) = crate::integrator::light_tracer::unsupported(&rs) {
-            return Err(CliError::Estimator(format!(
-                "{kind:?}: {why}; render this scene with Path"
-            )));
-        }
-        if rs.settings.target_error.is_some() {
-            return Err(CliError::Estimator(format!(
-                "{kind:?} renders a fixed number of samples; a target error needs Path"
-            )));
-        }
+    // `Auto` takes the path tracer for a target error.
+    if kind != Estimator::Path && kind != Estimator::Auto && rs.settings.target_error.is_some() {
+        return Err(CliError::Estimator(format!(
+            "{kind:?} renders a fixed number of samples; a target error needs Path"
+        )));
     }
     Ok(rs)
 }

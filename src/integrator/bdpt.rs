@@ -18,15 +18,22 @@
 //! wavelengths; a connection keeps the hero alone when either side's vertices dispersed.
 //! Like light tracing, the estimator splats: each work item adds its values in fixed point,
 //! so the image is the same on any thread count.
+//!
+//! MEDIA: both subpaths sample their free flight inside a medium; a scattering event there
+//! is a vertex whose phase function connects as a BSDF does (no cosine, its own adjoint), and
+//! every connection carries the transmittance along it, across media's boundaries. The MIS
+//! weights leave the free-flight densities out: weights stay unbiased so long as every
+//! strategy of a path computes the same densities for it.
 
-use super::bsdf::{Frame, Mode};
-use super::ctx::{Ctx, DIM_BOUNCE, DIMS_PER_BOUNCE};
+use super::bsdf::{Frame, LaneChannels, Mode};
+use super::ctx::{Ctx, DIM_BOUNCE, DIM_MEDIA, DIMS_PER_BOUNCE};
 use super::light::Glossy;
 use super::light_tracer::{Camera, Splats, path_state};
 use super::material::{self, Vertex};
+use super::media::Flight;
 use super::microfacet::RoughDielectric;
 use super::state::{C, M, MAX_W, Paths, U};
-use super::surface::{CLASS_NONE, Surface};
+use super::surface::{CLASS_BOUNDARY, CLASS_NONE, Surface};
 use super::transport::{ChannelArray, Transport};
 use super::{Observer, RenderOptions, RenderOutput, RenderStats};
 use crate::components::Material;
@@ -34,6 +41,7 @@ use crate::film::{Tile, TileWork};
 use crate::geometry::{Ray, offset_ray_origin};
 use crate::scene::RenderScene;
 use crate::scene::lights::LightKind;
+use crate::scene::primitives::NO_MEDIUM;
 use crate::scene_file::schema::Estimator;
 use crate::simd::V3;
 use glam::{Vec2, Vec3};
@@ -42,6 +50,10 @@ use std::f32::consts::PI;
 /// First sample dimension of the light subpath: its emission takes the block there, event k
 /// the block `k + 1` after it. Far from the camera subpath's events and the media's range.
 pub const DIM_LIGHT_PATH: u32 = 1 << 21;
+
+/// MEDIA: first sample dimension of the light subpath's medium segments, as [`DIM_MEDIA`]
+/// is the camera subpath's.
+const DIM_LIGHT_MEDIA: u32 = DIM_LIGHT_PATH + DIM_MEDIA;
 
 /// Which strategies a render adds (a debugging view, as pbrt's `visualize_strategies`).
 #[derive(Clone, Copy, Debug, PartialEq, Eq)]
@@ -74,6 +86,16 @@ struct GlossyParts {
     rough_dielectric: RoughDielectric<f32>,
 }
 
+/// What scatters at a connectible vertex: a surface's BSDF, or a medium's phase function
+/// (Henyey–Greenstein, asymmetry `g`).
+// Unboxed: vertices live in buffers reused from sample to sample, and a box would allocate
+// per vertex.
+#[allow(clippy::large_enum_variant)]
+enum Scatter<const N: usize> {
+    Surface(Surface<f32, N>, GlossyParts),
+    Phase(f32),
+}
+
 /// A vertex of either subpath.
 struct Vtx<T: Transport, const N: usize> {
     /// The point; at infinity, the unit direction towards it from the scene.
@@ -96,8 +118,10 @@ struct Vtx<T: Transport, const N: usize> {
     rev: f32,
     /// The BSDF sampled a delta lobe here.
     delta: bool,
-    /// The BSDF at a vertex with a density (a surface that connects).
-    bsdf: Option<(Surface<f32, N>, GlossyParts)>,
+    /// The BSDF or phase function at a vertex with a density (one that connects).
+    bsdf: Option<Scatter<N>>,
+    /// MEDIA: the medium the subpath arrived in (at its start: the one it leaves into).
+    medium: u32,
     /// The camera subpath's emitter hit: radiance towards the previous vertex, primitive.
     emits: Option<(C<f32, N>, u32)>,
     /// The first sample dimension of the event at this vertex.
@@ -129,6 +153,7 @@ impl<T: Transport, const N: usize> Vtx<T, N> {
             rev: 0.0,
             delta: false,
             bsdf: None,
+            medium: NO_MEDIUM,
             emits: None,
             dim,
         }
@@ -254,6 +279,104 @@ impl<'a, const N: usize> Bsdf<'a, N> {
     }
 }
 
+/// A connectible vertex's scattering as the strategies evaluate it: a surface's BSDF, or a
+/// medium's phase function, which is its own adjoint and needs no shading-normal factor
+/// (the vertex's throughput already holds σs).
+enum Scatterer<'a, const N: usize> {
+    Bsdf(Bsdf<'a, N>),
+    Phase(f32),
+}
+
+/// The scattering at vertex `v`, if it connects.
+#[inline(always)]
+fn scatterer<'a, T: Transport, const N: usize>(
+    ctx: &'a Ctx,
+    v: &'a Vtx<T, N>,
+) -> Option<Scatterer<'a, N>> {
+    Some(match v.bsdf.as_ref()? {
+        Scatter::Surface(sf, parts) => Scatterer::Bsdf(Bsdf::new(ctx, sf, parts)),
+        Scatter::Phase(g) => Scatterer::Phase(*g),
+    })
+}
+
+impl<const N: usize> Scatterer<'_, N> {
+    /// See [`Bsdf::pdf`]; a phase function's density is its value.
+    #[inline(always)]
+    fn pdf(&self, wo: Vec3, wi: Vec3) -> f32 {
+        match self {
+            Scatterer::Bsdf(b) => b.pdf(wo, wi),
+            Scatterer::Phase(g) => crate::medium::hg_phase_dirs(wo, wi, *g),
+        }
+    }
+
+    /// See [`Bsdf::camera_side`].
+    #[inline(always)]
+    fn camera_side(&self, wo: Vec3, wi: Vec3) -> Option<(C<f32, N>, f32)> {
+        match self {
+            Scatterer::Bsdf(b) => b.camera_side(wo, wi),
+            Scatterer::Phase(g) => phase_value(wo, wi, *g),
+        }
+    }
+
+    /// See [`Bsdf::light_side`].
+    #[inline(always)]
+    fn light_side(&self, wl: Vec3, wc: Vec3) -> Option<(C<f32, N>, f32)> {
+        match self {
+            Scatterer::Bsdf(b) => b.light_side(wl, wc),
+            Scatterer::Phase(g) => phase_value(wl, wc, *g),
+        }
+    }
+}
+
+/// The phase function between `wo` and `wi` (both away from the point), as value and density.
+#[inline(always)]
+fn phase_value<const N: usize>(wo: Vec3, wi: Vec3, g: f32) -> Option<(C<f32, N>, f32)> {
+    let p = crate::medium::hg_phase_dirs(wo, wi, g);
+    (p > 0.0).then(|| (C::<f32, N>::splat(p), p))
+}
+
+/// MEDIA: the medium a connection leaving vertex `v` along `w` starts in: the one the subpath
+/// arrived in, unless `w` leaves a surface on its far side, where it is the medium beyond.
+#[inline(always)]
+fn medium_toward<T: Transport, const N: usize>(ctx: &Ctx, v: &Vtx<T, N>, w: Vec3) -> u32 {
+    match &v.bsdf {
+        Some(Scatter::Surface(sf, _)) if w.dot(v.ng) < 0.0 => ctx
+            .scene
+            .prims
+            .medium_after_crossing(sf.prim[0], sf.front, v.medium),
+        _ => v.medium,
+    }
+}
+
+/// The transmittance between `a` and `b` (ends as [`segment_ray`]'s), leaving `a` in
+/// `medium`: `None` where the segment is blocked; without MEDIA, 1 where it is clear.
+#[allow(clippy::too_many_arguments)]
+#[inline(always)]
+fn segment_tr<
+    T: Transport<S: ChannelArray<N>>,
+    const N: usize,
+    const MOTION: bool,
+    const MEDIA: bool,
+>(
+    ctx: &Ctx,
+    a: Vec3,
+    na: Vec3,
+    b: Vec3,
+    nb: Vec3,
+    medium: u32,
+    time: f32,
+    lam: &T::Lanes<f32>,
+) -> Option<C<f32, N>> {
+    let (ray, t_max) = segment_ray(a, na, b, nb);
+    if MEDIA {
+        super::light_tracer::transmittance_along::<T, N, MOTION>(
+            ctx, &ray, t_max, medium, time, lam,
+        )
+    } else {
+        (!ctx.scene.occluded::<MOTION>(&ray, t_max, time)).then(|| C::<f32, N>::splat(1.0))
+    }
+}
+
 /// Converts a solid-angle density at `from` towards `to` into an area density at `to`. A
 /// direction at infinity keeps its solid-angle density; from infinity, `pdf` is the planar
 /// density of the parallel rays' origins, and only `to`'s cosine converts it.
@@ -280,10 +403,10 @@ fn density<T: Transport, const N: usize>(pdf: f32, from: &Vtx<T, N>, to: &Vtx<T,
     pdf * cos_to(d / r2.sqrt()) / r2
 }
 
-/// Whether the segment between `a` and `b` is clear, each end offset off its surface (`na`,
-/// `nb`; zero at the lens and at a point light).
+/// The ray from `a` to `b` (at parameter 1), each end offset off its surface (`na`, `nb`;
+/// zero on no surface), and the parameter it stops at.
 #[inline(always)]
-fn unoccluded<const MOTION: bool>(ctx: &Ctx, a: Vec3, na: Vec3, b: Vec3, nb: Vec3, t: f32) -> bool {
+fn segment_ray(a: Vec3, na: Vec3, b: Vec3, nb: Vec3) -> (Ray, f32) {
     let d = b - a;
     let off = |p: Vec3, n: Vec3, towards: Vec3| {
         if n == Vec3::ZERO {
@@ -300,7 +423,7 @@ fn unoccluded<const MOTION: bool>(ctx: &Ctx, a: Vec3, na: Vec3, b: Vec3, nb: Vec
     } else {
         1.0
     };
-    !ctx.scene.occluded::<MOTION>(&Ray::new(o, e - o), t_max, t)
+    (Ray::new(o, e - o), t_max)
 }
 
 /// A strategy's value in the transport's channels, and the wavelengths that carry it.
@@ -374,10 +497,17 @@ fn mis_weight<T: Transport, const N: usize>(
 /// A subpath's walk: from the state `st` (its first ray), intersects and scatters through the
 /// kernel's stages, pushing a vertex per hit until the path ends or `path` holds `max`
 /// vertices; `pdf_dir` is the solid-angle density of the first ray. `LIGHT` subpaths carry
-/// importance.
+/// importance. MEDIA: a subpath inside a medium first samples its free flight, as the path
+/// tracer's does; one that scatters there pushes a vertex with the medium's phase function.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn walk<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool, const LIGHT: bool>(
+fn walk<
+    T: Transport<S: ChannelArray<N>>,
+    const N: usize,
+    const MOTION: bool,
+    const MEDIA: bool,
+    const LIGHT: bool,
+>(
     ctx: &Ctx,
     st: &mut Paths<f32, T, N>,
     path: &mut Vec<Vtx<T, N>>,
@@ -391,8 +521,36 @@ fn walk<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool, co
         stats.rays += 1;
         stats.lane_slots += 1;
         let hits = scene.intersect_packet::<f32, MOTION>(st.o, st.d, true, st.time);
-        let sf = super::surface::surfaces::<f32, T, N, MOTION, false>(ctx, st, &hits, true);
         let prev = path.len() - 1;
+        if MEDIA && st.in_medium {
+            let base = if LIGHT { DIM_LIGHT_MEDIA } else { DIM_MEDIA };
+            match super::media::flight(ctx, st, &hits, base) {
+                Flight::Passes => {}
+                Flight::Ends => break,
+                Flight::Scatters { p, g, dim } => {
+                    // A vertex in the medium.
+                    let wo = -st.d.lane(0);
+                    let mut v = Vtx {
+                        wo,
+                        medium: st.medium[0],
+                        ..Vtx::<T, N>::start(p, false, Vec3::ZERO, st.beta, st.lam, 0.0, dim + 2)
+                    };
+                    v.fwd = density(pdf_dir, &path[prev], &v);
+                    if LIGHT || path.len() + 1 < max {
+                        v.bsdf = Some(Scatter::Phase(g));
+                    }
+                    path.push(v);
+                    if path.len() >= max {
+                        break;
+                    }
+                    // The phase function is symmetric: the reverse density is the forward one.
+                    pdf_dir = super::media::scatter_phase(ctx, st, p, g, dim);
+                    path[prev].rev = density(pdf_dir, &path[prev + 1], &path[prev]);
+                    continue;
+                }
+            }
+        }
+        let sf = super::surface::surfaces::<f32, T, N, MOTION, MEDIA>(ctx, st, &hits, true);
         let dim = first_dim + st.depth * DIMS_PER_BOUNCE;
         if !sf.hit {
             // The camera subpath that escapes meets the environment (s = 0).
@@ -404,9 +562,16 @@ fn walk<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool, co
             }
             break;
         }
+        if MEDIA && sf.class == CLASS_BOUNDARY {
+            // A medium's boundary: on in the same direction, in the medium beyond.
+            st.o = V3::splat(offset_ray_origin(sf.p.lane(0), -sf.nf.lane(0)));
+            super::media::cross(ctx, st, &sf, true);
+            continue;
+        }
         let (p, ng) = (sf.p.lane(0), sf.nf.lane(0));
         let mut v = Vtx {
             wo: -st.d.lane(0),
+            medium: st.medium[0],
             ..Vtx::<T, N>::start(p, false, ng, st.beta, st.lam, 0.0, dim)
         };
         v.fwd = density(pdf_dir, &path[prev], &v);
@@ -426,7 +591,7 @@ fn walk<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool, co
         let wo = -st.d;
         let eta_scale = st.eta_scale;
         let mut keep = Keep::<LIGHT> { parts: None };
-        material::scatter::<f32, T, N, MOTION, false, _>(
+        material::scatter::<f32, T, N, MOTION, MEDIA, _>(
             ctx, st, &sf, true, stats, first_dim, &mut keep,
         );
         if LIGHT {
@@ -463,7 +628,7 @@ fn walk<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool, co
             super::light_tracer::adjoint_correction(st, wo, &sf);
         }
         if let Some(parts) = keep.parts {
-            v.bsdf = Some((sf, parts));
+            v.bsdf = Some(Scatter::Surface(sf, parts));
         }
         path.push(v);
         // The light subpath's last vertex still needed its BSDF, for t = 1.
@@ -508,10 +673,16 @@ struct Subpaths<T: Transport, const N: usize> {
 /// Renders the samples `work` names of every pixel of `tile`: per sample, both subpaths and
 /// the strategies `which` asks for, into `splats`.
 #[allow(clippy::too_many_arguments)]
-fn trace_tile<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
+fn trace_tile<
+    T: Transport<S: ChannelArray<N>>,
+    const N: usize,
+    const MOTION: bool,
+    const MEDIA: bool,
+>(
     ctx: &Ctx,
     camera: &Camera,
     which: Strategies,
+    holders: &[u32],
     tile: &Tile,
     work: &TileWork,
     splats: &mut Splats,
@@ -529,8 +700,8 @@ fn trace_tile<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bo
             let (index, half) = work.index(first + k);
             let pixel = (y * ctx.width + x) | half;
             stats.samples += 1;
-            let rgb = sample::<T, N, MOTION>(
-                ctx, camera, which, &mut paths, x, y, pixel, index, splats, stats,
+            let rgb = sample::<T, N, MOTION, MEDIA>(
+                ctx, camera, which, holders, &mut paths, x, y, pixel, index, splats, stats,
             );
             if rgb.is_finite() {
                 splats.add_pixel(x, y, rgb);
@@ -544,10 +715,16 @@ fn trace_tile<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bo
 /// One camera sample: both subpaths, then every strategy. Returns the value of the sample's
 /// own pixel; light-tracing strategies (t = 1) splat where they land.
 #[allow(clippy::too_many_arguments)]
-fn sample<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
+fn sample<
+    T: Transport<S: ChannelArray<N>>,
+    const N: usize,
+    const MOTION: bool,
+    const MEDIA: bool,
+>(
     ctx: &Ctx,
     camera: &Camera,
     which: Strategies,
+    holders: &[u32],
     paths: &mut Subpaths<T, N>,
     x: u32,
     y: u32,
@@ -566,13 +743,21 @@ fn sample<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
     let init = T::initial_beta::<f32, N>(&lam);
     let cam = &mut paths.cam;
     cam.clear();
-    cam.push(Vtx::start(o, false, Vec3::ZERO, init, lam, 1.0, 0));
+    let camera_medium = ctx.scene.camera_medium;
+    cam.push(Vtx {
+        medium: camera_medium,
+        ..Vtx::start(o, false, Vec3::ZERO, init, lam, 1.0, 0)
+    });
     let lanes = crate::simd::Lanes::scalar();
     let mut st = path_state::<T, N>(o, d, init, lam, 1.0, time, pixel, index);
+    if MEDIA {
+        st.medium[0] = camera_medium;
+        st.in_medium = camera_medium != NO_MEDIUM;
+    }
     let pdf_cam = camera.pdf_dir::<MOTION>(time, d);
     super::run_at(
         lanes,
-        Walk::<T, N, MOTION, false> {
+        Walk::<T, N, MOTION, MEDIA, false> {
             ctx,
             st: &mut st,
             path: cam,
@@ -603,12 +788,18 @@ fn sample<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
         // disc is not a vertex.
         let inf = e.at_infinity;
         let p = if inf { -e.d } else { e.p };
-        light.push(Vtx::start(p, inf, e.n, init, lam, e.pdf_pos, dim));
+        let mut st = e.path::<T, N>(init * chan(e.beta), lam, time, pixel, index);
+        let mut v = Vtx::start(p, inf, e.n, init, lam, e.pdf_pos, dim);
+        if MEDIA {
+            v.medium = ctx.scene.prims.medium_among(st.o.lane(0), holders);
+            st.medium[0] = v.medium;
+            st.in_medium = v.medium != NO_MEDIUM;
+        }
+        light.push(v);
         if max_depth >= 1 {
-            let mut st = e.path::<T, N>(init * chan(e.beta), lam, time, pixel, index);
             super::run_at(
                 lanes,
-                Walk::<T, N, MOTION, true> {
+                Walk::<T, N, MOTION, MEDIA, true> {
                     ctx,
                     st: &mut st,
                     path: light,
@@ -622,7 +813,7 @@ fn sample<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
     }
     super::run_at(
         lanes,
-        Joins::<T, N, MOTION> {
+        Joins::<T, N, MOTION, MEDIA> {
             ctx,
             camera,
             which,
@@ -636,7 +827,15 @@ fn sample<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
 }
 
 /// A subpath's walk, run inside the width-1 FMA entry point (see [`Joins`]).
-struct Walk<'a, 'c, T: Transport, const N: usize, const MOTION: bool, const LIGHT: bool> {
+struct Walk<
+    'a,
+    'c,
+    T: Transport,
+    const N: usize,
+    const MOTION: bool,
+    const MEDIA: bool,
+    const LIGHT: bool,
+> {
     ctx: &'a Ctx<'c>,
     st: &'a mut Paths<f32, T, N>,
     path: &'a mut Vec<Vtx<T, N>>,
@@ -646,13 +845,18 @@ struct Walk<'a, 'c, T: Transport, const N: usize, const MOTION: bool, const LIGH
     stats: &'a mut RenderStats,
 }
 
-impl<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool, const LIGHT: bool>
-    crate::simd::LaneKernel for Walk<'_, '_, T, N, MOTION, LIGHT>
+impl<
+    T: Transport<S: ChannelArray<N>>,
+    const N: usize,
+    const MOTION: bool,
+    const MEDIA: bool,
+    const LIGHT: bool,
+> crate::simd::LaneKernel for Walk<'_, '_, T, N, MOTION, MEDIA, LIGHT>
 {
     type Output = ();
     #[inline(always)]
     fn run<F: crate::simd::Float>(self) {
-        walk::<T, N, MOTION, LIGHT>(
+        walk::<T, N, MOTION, MEDIA, LIGHT>(
             self.ctx,
             self.st,
             self.path,
@@ -668,7 +872,7 @@ impl<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool, const
 /// code outside the lanes' entry points calls libm for each `f32::mul_add`. The walks and
 /// the joins are three entries per sample rather than one, which keeps each function the
 /// compiler optimises of a size it handles quickly.
-struct Joins<'a, 'c, T: Transport, const N: usize, const MOTION: bool> {
+struct Joins<'a, 'c, T: Transport, const N: usize, const MOTION: bool, const MEDIA: bool> {
     ctx: &'a Ctx<'c>,
     camera: &'a Camera<'c>,
     which: Strategies,
@@ -679,13 +883,13 @@ struct Joins<'a, 'c, T: Transport, const N: usize, const MOTION: bool> {
     stats: &'a mut RenderStats,
 }
 
-impl<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool> crate::simd::LaneKernel
-    for Joins<'_, '_, T, N, MOTION>
+impl<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool, const MEDIA: bool>
+    crate::simd::LaneKernel for Joins<'_, '_, T, N, MOTION, MEDIA>
 {
     type Output = Vec3;
     #[inline(always)]
     fn run<F: crate::simd::Float>(self) -> Vec3 {
-        joins::<T, N, MOTION>(
+        joins::<T, N, MOTION, MEDIA>(
             self.ctx,
             self.camera,
             self.which,
@@ -702,7 +906,12 @@ impl<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool> crate
 /// pixel, the t = 1 strategies splatted where they land.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn joins<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
+fn joins<
+    T: Transport<S: ChannelArray<N>>,
+    const N: usize,
+    const MOTION: bool,
+    const MEDIA: bool,
+>(
     ctx: &Ctx,
     camera: &Camera,
     which: Strategies,
@@ -733,7 +942,7 @@ fn joins<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
             };
             if t == 1 {
                 let key = (pixel, index);
-                if let Some(((c, lam), conn)) = light_to_camera::<T, N, MOTION>(
+                if let Some(((c, lam), conn)) = light_to_camera::<T, N, MOTION, MEDIA>(
                     ctx, camera, cam, light, s, all, key, time, stats,
                 ) {
                     let mut rgb = [Vec3::ZERO; MAX_W];
@@ -748,8 +957,16 @@ fn joins<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
             }
             let got = match s {
                 0 => emitter_hit::<T, N>(ctx, cam, t, all),
-                1 => light_sample::<T, N, MOTION>(ctx, cam, t, all, (pixel, index), time, stats),
-                _ => connect::<T, N, MOTION>(ctx, cam, light, s, t, all, time, stats),
+                1 => light_sample::<T, N, MOTION, MEDIA>(
+                    ctx,
+                    cam,
+                    t,
+                    all,
+                    (pixel, index),
+                    time,
+                    stats,
+                ),
+                _ => connect::<T, N, MOTION, MEDIA>(ctx, cam, light, s, t, all, time, stats),
             };
             if let Some((c, lam)) = got {
                 let mut rgb = [Vec3::ZERO; MAX_W];
@@ -859,7 +1076,12 @@ fn environment_hit<T: Transport<S: ChannelArray<N>>, const N: usize>(
 /// from the event's dimensions). Returns the value, its wavelengths and the raster point.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn light_to_camera<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
+fn light_to_camera<
+    T: Transport<S: ChannelArray<N>>,
+    const N: usize,
+    const MOTION: bool,
+    const MEDIA: bool,
+>(
     ctx: &Ctx,
     camera: &Camera,
     cam: &[Vtx<T, N>],
@@ -871,17 +1093,27 @@ fn light_to_camera<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTIO
     stats: &mut RenderStats,
 ) -> Option<(Value<T, N>, (f32, f32))> {
     let qs = &light[s - 1];
-    let (sf, parts) = qs.bsdf.as_ref()?;
+    let bsdf = scatterer(ctx, qs)?;
     let u = ctx.sampler.get_2d_lanes::<f32>(key.0, key.1, qs.dim + 1);
     let conn = camera.connect::<MOTION>(qs.p, time, u)?;
-    let bsdf = Bsdf::new(ctx, sf, parts);
     let (f, _) = bsdf.light_side(qs.wo, conn.wc)?;
     let mut c = qs.beta * f * conn.importance;
     if c.is_zero() {
         return None;
     }
     stats.shadow_rays += 1;
-    if !camera.visible::<MOTION>(qs.p, qs.ng, &conn, time) {
+    if MEDIA {
+        let ray = camera.ray_from(qs.p, qs.ng, &conn);
+        let m = medium_toward(ctx, qs, conn.wc);
+        c = c * super::light_tracer::transmittance_along::<T, N, MOTION>(
+            ctx,
+            &ray,
+            1.0 - 1e-4,
+            m,
+            time,
+            &qs.lam,
+        )?;
+    } else if !camera.visible::<MOTION>(qs.p, qs.ng, &conn, time) {
         return None;
     }
     let lam = joined::<T, N>(&qs.lam, &cam[0].lam, &mut c);
@@ -892,12 +1124,18 @@ fn light_to_camera<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTIO
         let rev = Rev {
             pt: 0.0,
             pt_minus: 0.0,
-            qs: conn.importance * conn.wc.dot(qs.ng).abs(),
+            qs: conn.importance * cosine(qs.ng, conn.wc),
             qs_minus: density(bsdf.pdf(conn.wc, qs.wo), qs, prev),
         };
         c = c * mis_weight(cam, light, s, 1, &rev, delta_light_of(light));
     }
     Some(((c, lam), (conn.fx, conn.fy)))
+}
+
+/// |cos| between direction `w` and normal `n`; 1 on no surface (a point in a medium).
+#[inline(always)]
+fn cosine(n: Vec3, w: Vec3) -> f32 {
+    if n == Vec3::ZERO { 1.0 } else { n.dot(w).abs() }
 }
 
 /// Whether the light subpath starts on a point or spot light (its start has no normal and
@@ -911,7 +1149,12 @@ fn delta_light_of<T: Transport, const N: usize>(light: &[Vtx<T, N>]) -> bool {
 /// point on the emitter when s = 1) through a shadow ray.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn connect<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
+fn connect<
+    T: Transport<S: ChannelArray<N>>,
+    const N: usize,
+    const MOTION: bool,
+    const MEDIA: bool,
+>(
     ctx: &Ctx,
     cam: &[Vtx<T, N>],
     light: &[Vtx<T, N>],
@@ -922,27 +1165,24 @@ fn connect<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>
     stats: &mut RenderStats,
 ) -> Option<Value<T, N>> {
     let (pt, qs) = (&cam[t - 1], &light[s - 1]);
-    let (sf_c, parts_c) = pt.bsdf.as_ref()?;
+    let bc = scatterer(ctx, pt)?;
     let d = qs.p - pt.p;
     let r2 = d.length_squared();
     if r2 == 0.0 {
         return None;
     }
     let w = d / r2.sqrt();
-    let bc = Bsdf::new(ctx, sf_c, parts_c);
     let (fc, pdf_c) = bc.camera_side(pt.wo, w)?;
     // The light side: the adjoint BSDF.
-    let (sf_l, parts_l) = qs.bsdf.as_ref()?;
-    let bl = Bsdf::new(ctx, sf_l, parts_l);
+    let bl = scatterer(ctx, qs)?;
     let (fl, pdf_l) = bl.light_side(qs.wo, -w)?;
     let mut c = pt.beta * fc * qs.beta * fl * (1.0 / r2);
     if c.is_zero() {
         return None;
     }
     stats.shadow_rays += 1;
-    if !unoccluded::<MOTION>(ctx, pt.p, pt.ng, qs.p, qs.ng, time) {
-        return None;
-    }
+    let m = medium_toward(ctx, pt, w);
+    c = c * segment_tr::<T, N, MOTION, MEDIA>(ctx, pt.p, pt.ng, qs.p, qs.ng, m, time, &pt.lam)?;
     let lam = joined::<T, N>(&pt.lam, &qs.lam, &mut c);
     if !weighted {
         return Some((c, lam));
@@ -964,7 +1204,12 @@ fn connect<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>
 /// so long as every strategy of a path is weighted by the same ones (pbrt does the same).
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn light_sample<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
+fn light_sample<
+    T: Transport<S: ChannelArray<N>>,
+    const N: usize,
+    const MOTION: bool,
+    const MEDIA: bool,
+>(
     ctx: &Ctx,
     cam: &[Vtx<T, N>],
     t: usize,
@@ -974,7 +1219,7 @@ fn light_sample<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: 
     stats: &mut RenderStats,
 ) -> Option<Value<T, N>> {
     let pt = &cam[t - 1];
-    let (sf_c, parts_c) = pt.bsdf.as_ref()?;
+    let bc = scatterer(ctx, pt)?;
     let scene = ctx.scene;
     // The camera subpath's walk leaves each event's light dimensions unused.
     let u_sel = ctx.sampler.get_1d_lanes::<f32>(key.0, key.1, pt.dim);
@@ -988,25 +1233,33 @@ fn light_sample<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: 
         ctx.textures,
     )?;
     let w = ls.wi;
-    let bc = Bsdf::new(ctx, sf_c, parts_c);
     let (fc, pdf_c) = bc.camera_side(pt.wo, w)?;
     let le = T::source_radiance(ctx, &ls.source, ls.radiance, &T::lane(&pt.lam, 0));
-    let c = pt.beta * fc * super::bsdf::Chan(le.to_array()) * (1.0 / ls.pdf);
+    let mut c = pt.beta * fc * super::bsdf::Chan(le.to_array()) * (1.0 / ls.pdf);
     if c.is_zero() {
         return None;
     }
     stats.shadow_rays += 1;
-    let clear = match ls.point {
-        Some((q, n)) => unoccluded::<MOTION>(ctx, pt.p, pt.ng, q, n, time),
+    let m = medium_toward(ctx, pt, w);
+    c = c * match ls.point {
+        Some((q, n)) => segment_tr::<T, N, MOTION, MEDIA>(ctx, pt.p, pt.ng, q, n, m, time, &pt.lam),
         None => {
             let n = if pt.ng.dot(w) >= 0.0 { pt.ng } else { -pt.ng };
             let ray = Ray::new(offset_ray_origin(pt.p, n), w);
-            !scene.occluded::<MOTION>(&ray, f32::INFINITY, time)
+            if MEDIA {
+                super::light_tracer::transmittance_along::<T, N, MOTION>(
+                    ctx,
+                    &ray,
+                    f32::INFINITY,
+                    m,
+                    time,
+                    &pt.lam,
+                )
+            } else {
+                (!scene.occluded::<MOTION>(&ray, f32::INFINITY, time)).then(|| C::splat(1.0))
+            }
         }
-    };
-    if !clear {
-        return None;
-    }
+    }?;
     if !weighted {
         return Some((c, pt.lam));
     }
@@ -1062,7 +1315,12 @@ fn light_start<T: Transport, const N: usize>(
 
 /// Renders `opts.spp` samples per pixel by BDPT (fewer if stopped or out of time), in
 /// passes, adding the strategies `which` names.
-pub(super) fn render<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
+pub(super) fn render<
+    T: Transport<S: ChannelArray<N>>,
+    const N: usize,
+    const MOTION: bool,
+    const MEDIA: bool,
+>(
     ctx: &Ctx,
     opts: &RenderOptions,
     tiles: &[Tile],
@@ -1070,8 +1328,14 @@ pub(super) fn render<T: Transport<S: ChannelArray<N>>, const N: usize, const MOT
     which: Strategies,
 ) -> RenderOutput {
     let camera = Camera::new(ctx);
+    // MEDIA: the shapes that hold a medium, where a light subpath's start is looked up.
+    let holders = if MEDIA {
+        ctx.scene.prims.medium_holders()
+    } else {
+        Vec::new()
+    };
     super::light_tracer::splat_passes(opts, ctx, tiles, progress, |tile, work, splats, stats| {
-        trace_tile::<T, N, MOTION>(ctx, &camera, which, tile, work, splats, stats)
+        trace_tile::<T, N, MOTION, MEDIA>(ctx, &camera, which, &holders, tile, work, splats, stats)
     })
 }
 
@@ -1081,18 +1345,15 @@ const PROBE_RAYS: u32 = 16384;
 /// The estimator `render.integrator.kind` resolves to, and why: `Auto` takes BDPT where a
 /// light reaches a specular or dispersive surface (a smooth dielectric, a dispersive one of
 /// any roughness, a mirror or a smooth conductor: the first vertex of caustic paths), the
-/// caustics carry at least 3 % of the light the camera sees on other surfaces, and BDPT
-/// can take the scene, or where the sun shines on such a surface; otherwise, and for a
-/// target error, the path tracer. Reach and share are found by 16,384 emission rays, drawn as
-/// light paths start (lights by power) and followed through specular chains. Other kinds
-/// resolve to themselves.
+/// caustics carry at least 3 % of the light the camera sees on other surfaces, or where the
+/// sun shines on such a surface; otherwise, and for a target error, the path tracer. Reach
+/// and share are found by 16,384 emission rays, drawn as light paths start (lights by power)
+/// and followed through specular chains and media's boundaries (media's attenuation is not
+/// weighed). Other kinds resolve to themselves.
 pub fn choose(scene: &RenderScene) -> (Estimator, String) {
     let kind = scene.settings.kind;
     if kind != Estimator::Auto {
         return (kind, "render.integrator.kind".into());
-    }
-    if let Some(why) = super::light_tracer::unsupported(scene) {
-        return (Estimator::Path, format!("Auto: {why}"));
     }
     if scene.settings.target_error.is_some() {
         return (Estimator::Path, "Auto: a target error needs Path".into());
@@ -1147,13 +1408,22 @@ pub fn choose(scene: &RenderScene) -> (Estimator, String) {
             offset_ray_origin(e.p, if e.n.dot(e.d) >= 0.0 { e.n } else { -e.n })
         };
         let mut ray = Ray::new(o, e.d);
-        for bounce in 0..=PROBE_CHAIN {
+        let mut bounce = 0;
+        // Media's boundaries are crossed without a bounce, a bounded number of times.
+        for _ in 0..=PROBE_CHAIN + 16 {
             let Some(hit) = scene.intersect::<false>(&ray, f32::INFINITY, time) else {
                 break;
             };
             let sp = prims.surface(&ray, &hit);
             let m = prims.materials[prims.material[hit.prim as usize] as usize];
+            if matches!(m, Material::Boundary) {
+                ray = Ray::new(offset_ray_origin(sp.p, -sp.facing()), ray.d);
+                continue;
+            }
             if caustic(hit.prim).is_some() {
+                if bounce == PROBE_CHAIN {
+                    break;
+                }
                 if bounce == 0 {
                     match hits.iter_mut().find(|h| h.0 == hit.prim && h.1 == light) {
                         Some(h) => h.2 += 1,
@@ -1174,6 +1444,7 @@ pub fn choose(scene: &RenderScene) -> (Estimator, String) {
                 };
                 let side = if d.dot(n) >= 0.0 { n } else { -n };
                 ray = Ray::new(offset_ray_origin(sp.p, side), d);
+                bounce += 1;
                 continue;
             }
             let albedo = match m {
@@ -1183,9 +1454,16 @@ pub fn choose(scene: &RenderScene) -> (Estimator, String) {
                 Material::Light { .. } | Material::Boundary => 0.0,
                 _ => 1.0,
             };
+            // Seen through media's boundaries: the probes weigh no medium's attenuation.
             if albedo > 0.0
                 && let Some(c) = camera.connect::<false>(sp.p, time, (0.5, 0.5))
-                && camera.visible::<false>(sp.p, sp.n, &c, time)
+                && scene.transmittance_with::<false, Vec3>(
+                    &camera.ray_from(sp.p, sp.n, &c),
+                    1.0 - 1e-4,
+                    time,
+                    NO_MEDIUM,
+                    |_, _| Vec3::ONE,
+                ) != Vec3::ZERO
             {
                 let cos = f64::from(sp.n.dot(c.wc).abs());
                 seen[usize::from(bounce > 0)] += power * albedo * cos * f64::from(c.importance);

@@ -14,14 +14,18 @@
 //! Splats land anywhere on the film, so each work item adds them in 64-bit fixed point:
 //! integer sums do not depend on their order, and the image is the same on any thread count.
 //! The paths run one at a time through the width-1 instantiation of the kernel's stages.
+//! MEDIA: a path inside a medium samples its free flight as the path tracer's does; where it
+//! scatters, it connects to the camera through the phase function. Connections carry the
+//! transmittance of the media and boundaries they cross.
 
 use super::bsdf::{Frame, LaneChannels, Mode};
-use super::ctx::{Ctx, DIM_BOUNCE, DIM_TIME, DIMS_PER_BOUNCE};
+use super::ctx::{Ctx, DIM_BOUNCE, DIM_MEDIA, DIM_TIME, DIMS_PER_BOUNCE};
 use super::light::Glossy;
 use super::material::{self, Vertex};
+use super::media::Flight;
 use super::state::{C, M, MAX_W, Paths, U, gdot};
-use super::surface::{CLASS_NONE, Surface};
-use super::transport::{ChannelArray, Transport};
+use super::surface::{CLASS_BOUNDARY, CLASS_NONE, Surface};
+use super::transport::{ChannelArray, MediumOps, Transport};
 use super::{Observer, RenderOptions, RenderOutput, RenderStats, uniform_passes};
 use crate::components::camera::CameraFrame;
 use crate::film::{Tile, TileWork};
@@ -36,15 +40,6 @@ use std::f32::consts::PI;
 use std::marker::PhantomData;
 use std::sync::atomic::Ordering;
 use std::time::Instant;
-
-/// Why the scene cannot be rendered from the lights (light tracing, BDPT), if it cannot
-/// (yet): participating media.
-pub fn unsupported(scene: &RenderScene) -> Option<String> {
-    if scene.effects.has(crate::scene::Effect::Media) {
-        return Some("paths from the lights do not handle participating media yet".into());
-    }
-    None
-}
 
 /// One in fixed point: splats are summed as integers in units of 2⁻³² (a pixel's sum may
 /// reach 2³¹ before it saturates).
@@ -238,12 +233,19 @@ impl<'a> Camera<'a> {
         c: &Connection,
         time: f32,
     ) -> bool {
-        let n = if n.dot(c.wc) >= 0.0 { n } else { -n };
-        let o = offset_ray_origin(p, n);
         // The lens lies on no surface: stop just short of it.
         !self
             .scene
-            .occluded::<MOTION>(&Ray::new(o, c.lens - o), 1.0 - 1e-4, time)
+            .occluded::<MOTION>(&self.ray_from(p, n, c), 1.0 - 1e-4, time)
+    }
+
+    /// The ray from `p` (leaving on the side of `n`; zero on no surface) to the lens point
+    /// of `c`, which it reaches at parameter 1.
+    #[inline(always)]
+    pub(super) fn ray_from(&self, p: Vec3, n: Vec3, c: &Connection) -> Ray {
+        let n = if n.dot(c.wc) >= 0.0 { n } else { -n };
+        let o = offset_ray_origin(p, n);
+        Ray::new(o, c.lens - o)
     }
 }
 
@@ -324,13 +326,88 @@ impl<T: Transport<S: ChannelArray<N>>, const N: usize> Vertex<f32, T, N> for Cam
             return;
         }
         stats.shadow_rays += 1;
-        if self
+        if MEDIA {
+            // Through a rough dielectric the connection starts in the medium beyond it.
+            let m = if through {
+                let prims = &ctx.scene.prims;
+                prims.medium_after_crossing(sf.prim[0], sf.front, st.medium[0])
+            } else {
+                st.medium[0]
+            };
+            let ray = self.camera.ray_from(p, sf.nf.lane(0), &conn);
+            if let Some(tr) =
+                transmittance_along::<T, N, MOTION>(ctx, &ray, 1.0 - 1e-4, m, st.time, &st.lam)
+            {
+                self.splat::<T, N>(&(c * tr), &st.lam, &conn);
+            }
+        } else if self
             .camera
             .visible::<MOTION>(p, sf.nf.lane(0), &conn, st.time)
         {
             self.splat::<T, N>(&c, &st.lam, &conn);
         }
     }
+}
+
+impl CameraVertex<'_, '_> {
+    /// MEDIA: connects the light path `st`, scattered at `p` in its medium (asymmetry `g`;
+    /// the event's dimensions from `dim`, see [`super::media::Flight`]), to the camera.
+    #[inline(always)]
+    fn medium_vertex<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
+        &mut self,
+        ctx: &Ctx,
+        st: &Paths<f32, T, N>,
+        (p, g, dim): (Vec3, f32, u32),
+        stats: &mut RenderStats,
+    ) {
+        let u = ctx
+            .sampler
+            .get_2d_lanes::<f32>(st.pixel, st.sample, dim + 3);
+        let Some(conn) = self.camera.connect::<MOTION>(p, st.time, u) else {
+            return;
+        };
+        let ph = crate::medium::hg_phase_dirs(-st.d.lane(0), conn.wc, g);
+        let c = st.beta * (ph * conn.importance);
+        if c.is_zero() {
+            return;
+        }
+        stats.shadow_rays += 1;
+        let ray = self.camera.ray_from(p, Vec3::ZERO, &conn);
+        let m = st.medium[0];
+        if let Some(tr) =
+            transmittance_along::<T, N, MOTION>(ctx, &ray, 1.0 - 1e-4, m, st.time, &st.lam)
+        {
+            self.splat::<T, N>(&(c * tr), &st.lam, &conn);
+        }
+    }
+}
+
+/// MEDIA: the transmittance along `ray` up to `t_max`, starting in `medium` and crossing
+/// medium boundaries, at the wavelengths `lam`; `None` where any other surface blocks it.
+#[inline(always)]
+pub(super) fn transmittance_along<
+    T: Transport<S: ChannelArray<N>>,
+    const N: usize,
+    const MOTION: bool,
+>(
+    ctx: &Ctx,
+    ray: &Ray,
+    t_max: f32,
+    medium: u32,
+    time: f32,
+    lam: &T::Lanes<f32>,
+) -> Option<C<f32, N>> {
+    let lam = T::lane(lam, 0);
+    let tr: T::S = ctx.scene.transmittance_with::<MOTION, T::S>(
+        ray,
+        t_max,
+        time,
+        medium,
+        #[inline(always)]
+        |m, d| T::medium(ctx, m, &lam).transmittance(d),
+    );
+    let c = super::bsdf::Chan(tr.to_array());
+    (!c.is_zero()).then_some(c)
 }
 
 /// A point and direction drawn on an emitter, with the throughput of the path they start.
@@ -674,9 +751,15 @@ pub(super) fn emit<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTIO
 /// The light paths of the samples `work` names of every pixel of `tile`.
 #[allow(clippy::too_many_arguments)]
 #[inline(always)]
-fn trace_tile<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
+fn trace_tile<
+    T: Transport<S: ChannelArray<N>>,
+    const N: usize,
+    const MOTION: bool,
+    const MEDIA: bool,
+>(
     ctx: &Ctx,
     camera: &Camera,
+    holders: &[u32],
     tile: &Tile,
     work: &TileWork,
     splats: &mut Splats,
@@ -713,14 +796,26 @@ fn trace_tile<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bo
                     super::generate::camera_rays_keyed::<f32, MOTION>(ctx, x, y, pixel, index);
                 let (o, d) = (ray.o.lane(0), ray.d.lane(0).normalize());
                 stats.rays += 1;
-                if scene
-                    .intersect::<MOTION>(&Ray::new(o, d), f32::INFINITY, time)
-                    .is_none()
-                {
+                // MEDIA: seen through the media and boundaries along the ray.
+                let tr = if MEDIA {
+                    let m = scene.camera_medium;
+                    transmittance_along::<T, N, MOTION>(
+                        ctx,
+                        &Ray::new(o, d),
+                        f32::INFINITY,
+                        m,
+                        time,
+                        &lam,
+                    )
+                } else {
+                    let hit = scene.intersect::<MOTION>(&Ray::new(o, d), f32::INFINITY, time);
+                    hit.is_none().then(|| C::<f32, N>::splat(1.0))
+                };
+                if let Some(tr) = tr {
                     let mut c = C::<f32, N>::splat(0.0);
                     each_infinite(ctx, |i| {
                         if let Some((le, _)) = infinite_light::<T>(ctx, i, &T::lane(&lam, 0), d) {
-                            c = c + init * chan(le);
+                            c = c + init * chan(le) * tr;
                         }
                     });
                     let mut rgb = [Vec3::ZERO; MAX_W];
@@ -756,26 +851,62 @@ fn trace_tile<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bo
                     if e.two_sided || cos > 0.0 {
                         let c = init * chan(e.le) * (cos.abs() * conn.importance);
                         stats.shadow_rays += 1;
-                        if !c.is_zero() && camera.visible::<MOTION>(e.p, e.n, &conn, time) {
+                        if c.is_zero() {
+                        } else if MEDIA {
+                            let ray = camera.ray_from(e.p, e.n, &conn);
+                            let m = scene.prims.medium_among(ray.o, holders);
+                            if let Some(tr) = transmittance_along::<T, N, MOTION>(
+                                ctx,
+                                &ray,
+                                1.0 - 1e-4,
+                                m,
+                                time,
+                                &lam,
+                            ) {
+                                vertex.splat::<T, N>(&(c * tr), &lam, &conn);
+                            }
+                        } else if camera.visible::<MOTION>(e.p, e.n, &conn, time) {
                             vertex.splat::<T, N>(&c, &lam, &conn);
                         }
                     }
                 }
             }
             let mut st = e.path::<T, N>(init * chan(e.beta), lam, time, pixel, index);
+            if MEDIA {
+                st.medium[0] = scene.prims.medium_among(st.o.lane(0), holders);
+                st.in_medium = st.medium[0] != NO_MEDIUM;
+            }
             while st.alive && st.depth < max_depth {
                 stats.rays += 1;
                 stats.lane_slots += 1;
                 let hits = scene.intersect_packet::<f32, MOTION>(st.o, st.d, true, time);
+                if MEDIA && st.in_medium {
+                    // A light path has no camera subpath: it takes the media's range.
+                    match super::media::flight(ctx, &mut st, &hits, DIM_MEDIA) {
+                        Flight::Passes => {}
+                        Flight::Ends => break,
+                        Flight::Scatters { p, g, dim } => {
+                            vertex.medium_vertex::<T, N, MOTION>(ctx, &st, (p, g, dim), stats);
+                            super::media::scatter_phase(ctx, &mut st, p, g, dim);
+                            continue;
+                        }
+                    }
+                }
                 let sf =
-                    super::surface::surfaces::<f32, T, N, MOTION, false>(ctx, &st, &hits, true);
+                    super::surface::surfaces::<f32, T, N, MOTION, MEDIA>(ctx, &st, &hits, true);
                 // Emitters absorb, as in the path tracer.
                 if !sf.hit || sf.class == CLASS_NONE {
                     break;
                 }
+                if MEDIA && sf.class == CLASS_BOUNDARY {
+                    // A medium's boundary: on in the same direction, in the medium beyond.
+                    st.o = V3::splat(offset_ray_origin(sf.p.lane(0), -sf.nf.lane(0)));
+                    super::media::cross(ctx, &mut st, &sf, true);
+                    continue;
+                }
                 let wo = -st.d;
                 let eta_scale = st.eta_scale;
-                material::scatter::<f32, T, N, MOTION, false, _>(
+                material::scatter::<f32, T, N, MOTION, MEDIA, _>(
                     ctx,
                     &mut st,
                     &sf,
@@ -796,7 +927,12 @@ fn trace_tile<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bo
 }
 
 /// Renders `opts.spp` light paths per pixel (fewer if stopped or out of time), in passes.
-pub(super) fn render<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool>(
+pub(super) fn render<
+    T: Transport<S: ChannelArray<N>>,
+    const N: usize,
+    const MOTION: bool,
+    const MEDIA: bool,
+>(
     ctx: &Ctx,
     opts: &RenderOptions,
     tiles: &[Tile],
@@ -804,10 +940,17 @@ pub(super) fn render<T: Transport<S: ChannelArray<N>>, const N: usize, const MOT
 ) -> RenderOutput {
     let camera = Camera::new(ctx);
     let lanes = crate::simd::Lanes::scalar();
+    // MEDIA: the shapes that hold a medium, where a light path's start is looked up.
+    let holders = if MEDIA {
+        ctx.scene.prims.medium_holders()
+    } else {
+        Vec::new()
+    };
     splat_passes(opts, ctx, tiles, progress, |tile, work, splats, stats| {
-        let job = TileJob::<T, N, MOTION> {
+        let job = TileJob::<T, N, MOTION, MEDIA> {
             ctx,
             camera: &camera,
+            holders: &holders,
             tile,
             work,
             splats,
@@ -821,9 +964,10 @@ pub(super) fn render<T: Transport<S: ChannelArray<N>>, const N: usize, const MOT
 /// One tile of light tracing, run at width 1 inside the lanes' FMA entry point: the paths'
 /// stages inline there, where `f32::mul_add` is one instruction (outside it, a call into
 /// libm).
-struct TileJob<'a, 'c, 'w, T, const N: usize, const MOTION: bool> {
+struct TileJob<'a, 'c, 'w, T, const N: usize, const MOTION: bool, const MEDIA: bool> {
     ctx: &'a Ctx<'c>,
     camera: &'a Camera<'c>,
+    holders: &'a [u32],
     tile: &'a Tile,
     work: &'a TileWork<'w>,
     splats: &'a mut Splats,
@@ -831,15 +975,16 @@ struct TileJob<'a, 'c, 'w, T, const N: usize, const MOTION: bool> {
     transport: PhantomData<T>,
 }
 
-impl<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool> crate::simd::LaneKernel
-    for TileJob<'_, '_, '_, T, N, MOTION>
+impl<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool, const MEDIA: bool>
+    crate::simd::LaneKernel for TileJob<'_, '_, '_, T, N, MOTION, MEDIA>
 {
     type Output = ();
     #[inline(always)]
     fn run<F: crate::simd::Float>(self) {
-        trace_tile::<T, N, MOTION>(
+        trace_tile::<T, N, MOTION, MEDIA>(
             self.ctx,
             self.camera,
+            self.holders,
             self.tile,
             self.work,
             self.splats,

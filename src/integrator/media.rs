@@ -424,3 +424,72 @@ fn shadow_ray_to_area(p: Vec3, q: Vec3, nq: Vec3) -> Ray {
     let nt = if nq.dot(d) <= 0.0 { nq } else { -nq };
     Ray::new(p, offset_ray_origin(q, nt) - p)
 }
+
+/// Width 1 (the splatting estimators' subpaths): what a path inside a medium does on its way
+/// to its hit.
+pub(super) enum Flight {
+    /// It reaches the hit, its throughput weighted for passing.
+    Passes,
+    /// No throughput is left: the path ends.
+    Ends,
+    /// It scatters at `p`, in a medium of asymmetry `g`; the event's dimensions are the
+    /// segment's block from `dim` (the light choice and the lens point at 2 to 4, as
+    /// [`free_flight`]'s light samples take them).
+    Scatters { p: Vec3, g: f32, dim: u32 },
+}
+
+/// Width 1: samples the free flight of the path `st`, inside a medium, towards `hits`, its
+/// segments' dimensions in blocks from `base` (as [`free_flight`], without its light samples).
+#[inline(always)]
+pub(super) fn flight<T: Transport<S: ChannelArray<N>>, const N: usize>(
+    ctx: &Ctx,
+    st: &mut Paths<f32, T, N>,
+    hits: &PacketHit<f32>,
+    base: u32,
+) -> Flight {
+    let med = T::medium(ctx, st.medium[0], &T::lane(&st.lam, 0));
+    let dim = base.wrapping_add(st.segments[0].wrapping_mul(DIMS_PER_SEGMENT));
+    st.segments[0] = st.segments[0].wrapping_add(1);
+    let u_c = ctx.sampler.get_1d(st.pixel, st.sample, dim);
+    let u_t = ctx.sampler.get_1d(st.pixel, st.sample, dim + 1);
+    let t_hit = if hits.hit { hits.t } else { f32::INFINITY };
+    let ff = lanes::sample_free_flight::<f32, N>(
+        &med.sigma_s().to_array(),
+        &med.sigma_t().to_array(),
+        t_hit,
+        u_c,
+        u_t,
+        &st.beta.0,
+    );
+    st.beta = st.beta * Chan(ff.weight);
+    if st.beta.is_zero() {
+        Flight::Ends
+    } else if ff.scatter {
+        let p = st.o.lane(0) + st.d.lane(0) * ff.t;
+        Flight::Scatters { p, g: med.g(), dim }
+    } else {
+        Flight::Passes
+    }
+}
+
+/// Width 1: the path `st` scattered at `p` ([`Flight::Scatters`]) takes its next direction
+/// from the phase function, then Russian roulette. Returns the direction's density.
+#[inline(always)]
+pub(super) fn scatter_phase<T: Transport<S: ChannelArray<N>>, const N: usize>(
+    ctx: &Ctx,
+    st: &mut Paths<f32, T, N>,
+    p: Vec3,
+    g: f32,
+    dim: u32,
+) -> f32 {
+    let u = ctx.sampler.get_2d(st.pixel, st.sample, dim + 5);
+    let (wi, pdf) = crate::medium::sample_hg(-st.d.lane(0), g, u);
+    st.depth += 1;
+    st.o = V3::splat(p);
+    st.d = V3::splat(wi);
+    st.prev_pdf = pdf;
+    st.prev_p = V3::splat(p);
+    st.specular = false;
+    roulette::russian_roulette(ctx, st, true, dim + 7);
+    pdf
+}

@@ -421,21 +421,16 @@ fn render_with<
     };
     let mut ctx = Ctx::new(scene, scene.effects.has(Effect::Lens)).with_spectral(&spectral);
     ctx.monochromatic = opts.monochromatic;
-    // A scene the splatting estimators cannot take yet is path traced (the CLI refuses it
-    // first), and so is a render to a target error, set here or in the scene: only the path
-    // tracer's passes keep the two halves the estimate needs.
+    // A render to a target error, set here or in the scene, is path traced: only the path
+    // tracer's passes keep the two halves the estimate needs (the CLI refuses the others).
     let (kind, _) = bdpt::choose(scene);
-    if kind != Estimator::Path
-        && opts.target_error.is_none()
-        && !MEDIA
-        && light_tracer::unsupported(scene).is_none()
-    {
+    if kind != Estimator::Path && opts.target_error.is_none() {
         let tiles = tiles(scene.settings.width, scene.settings.height);
         if kind == Estimator::LightTracing {
-            return light_tracer::render::<T, N, MOTION>(&ctx, opts, &tiles, progress);
+            return light_tracer::render::<T, N, MOTION, MEDIA>(&ctx, opts, &tiles, progress);
         }
         let which = opts.strategy.unwrap_or(bdpt::Strategies::All);
-        return bdpt::render::<T, N, MOTION>(&ctx, opts, &tiles, progress, which);
+        return bdpt::render::<T, N, MOTION, MEDIA>(&ctx, opts, &tiles, progress, which);
     }
     let pass = Passes::<T, N, MEDIA, MOTION> {
         ctx: &ctx,

@@ -538,6 +538,27 @@ impl Primitives {
         }
     }
 
+    /// The primitives that hold a medium, for [`Self::medium_among`].
+    pub fn medium_holders(&self) -> Vec<u32> {
+        (0..self.len() as u32)
+            .filter(|&i| self.medium_inside[i as usize] != NO_MEDIUM)
+            .collect()
+    }
+
+    /// [`Self::medium_at`] over `holders` ([`Self::medium_holders`]) alone: no pass over
+    /// every primitive.
+    pub fn medium_among(&self, p: Vec3, holders: &[u32]) -> u32 {
+        let mut best = (f32::INFINITY, NO_MEDIUM);
+        for &i in holders {
+            if let Some(v) = self.contains(i, p)
+                && v < best.0
+            {
+                best = (v, self.medium_inside[i as usize]);
+            }
+        }
+        best.1
+    }
+
     /// The medium at point `p`: that of the smallest medium shape containing it.
     pub fn medium_at(&self, p: Vec3) -> u32 {
         self.medium_at_excluding(p, None)

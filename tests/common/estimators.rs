@@ -241,3 +241,41 @@ pub const STUDIO_MAP: (&str, &str) = (
 
 /// A constant environment in place of [`OUTDOOR`]'s sky.
 pub const GREY_SKY: (&str, &str) = ("environment", "Constant(Rgb(0.6, 0.7, 0.8))");
+
+/// Fog in a box on the floor, lit by a point light and a spot outside it and a disk lamp
+/// inside; the camera outside. A diffuse ball stands in the fog, and a glass ball filled
+/// with a coloured scattering medium (a dielectric that is also a medium's boundary) floats
+/// in it (media nest: a shape's outside is one medium): connections and light subpaths cross
+/// both kinds of boundary, and vertices in either medium connect through the phase function.
+/// The fog's floor lies just below the floor's surface, so no ray meets both at once.
+/// Chromatic coefficients exercise the per-channel free-flight weights.
+pub const FOG_BOX: &str = r#"Scene(
+    render: (width: 24, height: 24, spp: 16, max_depth: 8, seed: 1),
+    camera: (position: (0.0, 1.4, 5.5), look_at: (0.0, 0.8, 0.0), fov_y: 45.0),
+    entities: [
+        (name: "fog", shape: Box(min: (-1.6, -0.01, -1.6), max: (1.6, 1.5, 1.6)),
+         medium: (sigma_a: Rgb(0.05, 0.1, 0.2), sigma_s: Rgb(0.6, 0.45, 0.3), g: 0.4)),
+        (name: "floor", shape: Rect(center: (0.0, 0.0, 0.0), u: (3.0, 0.0, 0.0), v: (0.0, 0.0, -3.0)),
+         material: Diffuse(albedo: Rgb(0.6, 0.6, 0.6))),
+        (name: "wall", shape: Rect(center: (0.0, 1.5, -2.0), u: (3.0, 0.0, 0.0), v: (0.0, 1.5, 0.0)),
+         material: Diffuse(albedo: Rgb(0.3, 0.5, 0.7))),
+        (name: "ball", shape: Sphere(center: (-0.7, 0.45, 0.0), radius: 0.45),
+         material: Diffuse(albedo: Rgb(0.8, 0.4, 0.2))),
+        (name: "glass", shape: Sphere(center: (0.7, 0.9, 0.4), radius: 0.4),
+         material: Dielectric(ior: Constant(1.5)),
+         medium: (sigma_a: Rgb(0.2, 0.8, 1.2), sigma_s: Rgb(1.0, 1.0, 1.0), g: -0.3)),
+        (name: "lamp", shape: Disk(center: (0.4, 1.2, -1.0), normal: (0.0, -1.0, 0.3), radius: 0.2),
+         material: Light(emission: Rgb(4.0, 4.0, 4.0))),
+        (name: "point", light: Point(position: (1.2, 2.6, 1.5), intensity: Rgb(6.0, 6.0, 6.0))),
+        (name: "spot", light: Spot(position: (-1.5, 2.8, 0.5), direction: (0.4, -1.0, -0.2), cone: 25.0,
+         falloff: 5.0, intensity: Rgb(8.0, 7.0, 6.0))),
+    ],
+)"#;
+
+/// [`FOG_BOX`] with a rough glass ball, which light tracing connects through.
+pub fn rough_fog_box() -> String {
+    FOG_BOX.replace(
+        "Dielectric(ior: Constant(1.5))",
+        "Dielectric(ior: Constant(1.5), alpha: 0.3)",
+    )
+}

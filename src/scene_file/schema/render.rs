@@ -180,8 +180,8 @@ pub enum Estimator {
     /// way, weighted by multiple importance sampling.
     Bdpt,
     /// `Bdpt` where a light reaches a specular or dispersive surface and the caustics carry
-    /// a measured share of what the camera sees, and BDPT can take the scene, else `Path`
-    /// (`prism info` says which, and why). The default.
+    /// a measured share of what the camera sees, else `Path` (`prism info` says which, and
+    /// why). The default.
     #[default]
     Auto,
 }
