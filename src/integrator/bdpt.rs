@@ -348,35 +348,6 @@ fn medium_toward<T: Transport, const N: usize>(ctx: &Ctx, v: &Vtx<T, N>, w: Vec3
     }
 }
 
-/// The transmittance between `a` and `b` (ends as [`segment_ray`]'s), leaving `a` in
-/// `medium`: `None` where the segment is blocked; without MEDIA, 1 where it is clear.
-#[allow(clippy::too_many_arguments)]
-#[inline(always)]
-fn segment_tr<
-    T: Transport<S: ChannelArray<N>>,
-    const N: usize,
-    const MOTION: bool,
-    const MEDIA: bool,
->(
-    ctx: &Ctx,
-    a: Vec3,
-    na: Vec3,
-    b: Vec3,
-    nb: Vec3,
-    medium: u32,
-    time: f32,
-    lam: &T::Lanes<f32>,
-) -> Option<C<f32, N>> {
-    let (ray, t_max) = segment_ray(a, na, b, nb);
-    if MEDIA {
-        super::light_tracer::transmittance_along::<T, N, MOTION>(
-            ctx, &ray, t_max, medium, time, lam,
-        )
-    } else {
-        (!ctx.scene.occluded::<MOTION>(&ray, t_max, time)).then(|| C::<f32, N>::splat(1.0))
-    }
-}
-
 /// Converts a solid-angle density at `from` towards `to` into an area density at `to`. A
 /// direction at infinity keeps its solid-angle density; from infinity, `pdf` is the planar
 /// density of the parallel rays' origins, and only `to`'s cosine converts it.
@@ -404,7 +375,7 @@ fn density<T: Transport, const N: usize>(pdf: f32, from: &Vtx<T, N>, to: &Vtx<T,
 }
 
 /// The ray from `a` to `b` (at parameter 1), each end offset off its surface (`na`, `nb`;
-/// zero on no surface), and the parameter it stops at.
+/// zero at the lens, at a point light and in a medium), and the parameter it stops at.
 #[inline(always)]
 fn segment_ray(a: Vec3, na: Vec3, b: Vec3, nb: Vec3) -> (Ray, f32) {
     let d = b - a;
@@ -1102,20 +1073,9 @@ fn light_to_camera<
         return None;
     }
     stats.shadow_rays += 1;
-    if MEDIA {
-        let ray = camera.ray_from(qs.p, qs.ng, &conn);
-        let m = medium_toward(ctx, qs, conn.wc);
-        c = c * super::light_tracer::transmittance_along::<T, N, MOTION>(
-            ctx,
-            &ray,
-            1.0 - 1e-4,
-            m,
-            time,
-            &qs.lam,
-        )?;
-    } else if !camera.visible::<MOTION>(qs.p, qs.ng, &conn, time) {
-        return None;
-    }
+    let m = medium_toward(ctx, qs, conn.wc);
+    let seen = Camera::seen_from::<T, N, MOTION, MEDIA>;
+    c = c * seen(camera, ctx, qs.p, qs.ng, &conn, m, time, &qs.lam)?;
     let lam = joined::<T, N>(&qs.lam, &cam[0].lam, &mut c);
     if weighted {
         let prev = &light[s - 2];
@@ -1182,7 +1142,9 @@ fn connect<
     }
     stats.shadow_rays += 1;
     let m = medium_toward(ctx, pt, w);
-    c = c * segment_tr::<T, N, MOTION, MEDIA>(ctx, pt.p, pt.ng, qs.p, qs.ng, m, time, &pt.lam)?;
+    let (ray, t_max) = segment_ray(pt.p, pt.ng, qs.p, qs.ng);
+    let tr = super::light_tracer::transmittance::<T, N, MOTION, MEDIA>;
+    c = c * tr(ctx, &ray, t_max, m, time, &pt.lam)?;
     let lam = joined::<T, N>(&pt.lam, &qs.lam, &mut c);
     if !weighted {
         return Some((c, lam));
@@ -1240,26 +1202,16 @@ fn light_sample<
         return None;
     }
     stats.shadow_rays += 1;
-    let m = medium_toward(ctx, pt, w);
-    c = c * match ls.point {
-        Some((q, n)) => segment_tr::<T, N, MOTION, MEDIA>(ctx, pt.p, pt.ng, q, n, m, time, &pt.lam),
+    let (ray, t_max) = match ls.point {
+        Some((q, n)) => segment_ray(pt.p, pt.ng, q, n),
         None => {
             let n = if pt.ng.dot(w) >= 0.0 { pt.ng } else { -pt.ng };
-            let ray = Ray::new(offset_ray_origin(pt.p, n), w);
-            if MEDIA {
-                super::light_tracer::transmittance_along::<T, N, MOTION>(
-                    ctx,
-                    &ray,
-                    f32::INFINITY,
-                    m,
-                    time,
-                    &pt.lam,
-                )
-            } else {
-                (!scene.occluded::<MOTION>(&ray, f32::INFINITY, time)).then(|| C::splat(1.0))
-            }
+            (Ray::new(offset_ray_origin(pt.p, n), w), f32::INFINITY)
         }
-    }?;
+    };
+    let m = medium_toward(ctx, pt, w);
+    let tr = super::light_tracer::transmittance::<T, N, MOTION, MEDIA>;
+    c = c * tr(ctx, &ray, t_max, m, time, &pt.lam)?;
     if !weighted {
         return Some((c, pt.lam));
     }

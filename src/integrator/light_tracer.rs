@@ -224,19 +224,28 @@ impl<'a> Camera<'a> {
         })
     }
 
-    /// Whether nothing lies between `p` (leaving on the side of `n`) and the lens point.
+    /// The transmittance between `p` (leaving on the side of `n`; zero on no surface, in
+    /// `medium`) and the lens point of `c`, as [`transmittance`] gives it.
+    #[allow(clippy::too_many_arguments)]
     #[inline(always)]
-    pub(super) fn visible<const MOTION: bool>(
+    pub(super) fn seen_from<
+        T: Transport<S: ChannelArray<N>>,
+        const N: usize,
+        const MOTION: bool,
+        const MEDIA: bool,
+    >(
         &self,
+        ctx: &Ctx,
         p: Vec3,
         n: Vec3,
         c: &Connection,
+        medium: u32,
         time: f32,
-    ) -> bool {
+        lam: &T::Lanes<f32>,
+    ) -> Option<C<f32, N>> {
         // The lens lies on no surface: stop just short of it.
-        !self
-            .scene
-            .occluded::<MOTION>(&self.ray_from(p, n, c), 1.0 - 1e-4, time)
+        let ray = self.ray_from(p, n, c);
+        transmittance::<T, N, MOTION, MEDIA>(ctx, &ray, 1.0 - 1e-4, medium, time, lam)
     }
 
     /// The ray from `p` (leaving on the side of `n`; zero on no surface) to the lens point
@@ -326,25 +335,17 @@ impl<T: Transport<S: ChannelArray<N>>, const N: usize> Vertex<f32, T, N> for Cam
             return;
         }
         stats.shadow_rays += 1;
-        if MEDIA {
-            // Through a rough dielectric the connection starts in the medium beyond it.
-            let m = if through {
-                let prims = &ctx.scene.prims;
-                prims.medium_after_crossing(sf.prim[0], sf.front, st.medium[0])
-            } else {
-                st.medium[0]
-            };
-            let ray = self.camera.ray_from(p, sf.nf.lane(0), &conn);
-            if let Some(tr) =
-                transmittance_along::<T, N, MOTION>(ctx, &ray, 1.0 - 1e-4, m, st.time, &st.lam)
-            {
-                self.splat::<T, N>(&(c * tr), &st.lam, &conn);
-            }
-        } else if self
-            .camera
-            .visible::<MOTION>(p, sf.nf.lane(0), &conn, st.time)
-        {
-            self.splat::<T, N>(&c, &st.lam, &conn);
+        // MEDIA: through a rough dielectric the connection starts in the medium beyond it.
+        let m = if through {
+            let prims = &ctx.scene.prims;
+            prims.medium_after_crossing(sf.prim[0], sf.front, st.medium[0])
+        } else {
+            st.medium[0]
+        };
+        let n = sf.nf.lane(0);
+        let seen = Camera::seen_from::<T, N, MOTION, MEDIA>;
+        if let Some(tr) = seen(self.camera, ctx, p, n, &conn, m, st.time, &st.lam) {
+            self.splat::<T, N>(&(c * tr), &st.lam, &conn);
         }
     }
 }
@@ -372,23 +373,23 @@ impl CameraVertex<'_, '_> {
             return;
         }
         stats.shadow_rays += 1;
-        let ray = self.camera.ray_from(p, Vec3::ZERO, &conn);
-        let m = st.medium[0];
-        if let Some(tr) =
-            transmittance_along::<T, N, MOTION>(ctx, &ray, 1.0 - 1e-4, m, st.time, &st.lam)
-        {
+        let (m, n) = (st.medium[0], Vec3::ZERO);
+        let seen = Camera::seen_from::<T, N, MOTION, true>;
+        if let Some(tr) = seen(self.camera, ctx, p, n, &conn, m, st.time, &st.lam) {
             self.splat::<T, N>(&(c * tr), &st.lam, &conn);
         }
     }
 }
 
-/// MEDIA: the transmittance along `ray` up to `t_max`, starting in `medium` and crossing
-/// medium boundaries, at the wavelengths `lam`; `None` where any other surface blocks it.
+/// The transmittance along `ray` up to `t_max` at the wavelengths `lam`: with MEDIA, starting
+/// in `medium` and crossing media's boundaries; without, 1 where nothing lies on the ray.
+/// `None` where a surface (other than a boundary) blocks it.
 #[inline(always)]
-pub(super) fn transmittance_along<
+pub(super) fn transmittance<
     T: Transport<S: ChannelArray<N>>,
     const N: usize,
     const MOTION: bool,
+    const MEDIA: bool,
 >(
     ctx: &Ctx,
     ray: &Ray,
@@ -397,6 +398,10 @@ pub(super) fn transmittance_along<
     time: f32,
     lam: &T::Lanes<f32>,
 ) -> Option<C<f32, N>> {
+    if !MEDIA {
+        let clear = !ctx.scene.occluded::<MOTION>(ray, t_max, time);
+        return clear.then(|| C::<f32, N>::splat(1.0));
+    }
     let lam = T::lane(lam, 0);
     let tr: T::S = ctx.scene.transmittance_with::<MOTION, T::S>(
         ray,
@@ -797,21 +802,9 @@ fn trace_tile<
                 let (o, d) = (ray.o.lane(0), ray.d.lane(0).normalize());
                 stats.rays += 1;
                 // MEDIA: seen through the media and boundaries along the ray.
-                let tr = if MEDIA {
-                    let m = scene.camera_medium;
-                    transmittance_along::<T, N, MOTION>(
-                        ctx,
-                        &Ray::new(o, d),
-                        f32::INFINITY,
-                        m,
-                        time,
-                        &lam,
-                    )
-                } else {
-                    let hit = scene.intersect::<MOTION>(&Ray::new(o, d), f32::INFINITY, time);
-                    hit.is_none().then(|| C::<f32, N>::splat(1.0))
-                };
-                if let Some(tr) = tr {
+                let (ray, m) = (Ray::new(o, d), scene.camera_medium);
+                let tr = transmittance::<T, N, MOTION, MEDIA>;
+                if let Some(tr) = tr(ctx, &ray, f32::INFINITY, m, time, &lam) {
                     let mut c = C::<f32, N>::splat(0.0);
                     each_infinite(ctx, |i| {
                         if let Some((le, _)) = infinite_light::<T>(ctx, i, &T::lane(&lam, 0), d) {
@@ -851,22 +844,20 @@ fn trace_tile<
                     if e.two_sided || cos > 0.0 {
                         let c = init * chan(e.le) * (cos.abs() * conn.importance);
                         stats.shadow_rays += 1;
-                        if c.is_zero() {
-                        } else if MEDIA {
-                            let ray = camera.ray_from(e.p, e.n, &conn);
-                            let m = scene.prims.medium_among(ray.o, holders);
-                            if let Some(tr) = transmittance_along::<T, N, MOTION>(
-                                ctx,
-                                &ray,
-                                1.0 - 1e-4,
-                                m,
-                                time,
-                                &lam,
-                            ) {
-                                vertex.splat::<T, N>(&(c * tr), &lam, &conn);
-                            }
-                        } else if camera.visible::<MOTION>(e.p, e.n, &conn, time) {
-                            vertex.splat::<T, N>(&c, &lam, &conn);
+                        // MEDIA: the medium on the camera's side of the emitter.
+                        let m = if MEDIA {
+                            let side = if e.n.dot(conn.wc) >= 0.0 { e.n } else { -e.n };
+                            scene
+                                .prims
+                                .medium_among(offset_ray_origin(e.p, side), holders)
+                        } else {
+                            NO_MEDIUM
+                        };
+                        let seen = Camera::seen_from::<T, N, MOTION, MEDIA>;
+                        if !c.is_zero()
+                            && let Some(tr) = seen(camera, ctx, e.p, e.n, &conn, m, time, &lam)
+                        {
+                            vertex.splat::<T, N>(&(c * tr), &lam, &conn);
                         }
                     }
                 }
