@@ -719,25 +719,21 @@ fn sample<
         medium: camera_medium,
         ..Vtx::start(o, false, Vec3::ZERO, init, lam, 1.0, 0)
     });
-    let lanes = crate::simd::Lanes::scalar();
     let mut st = path_state::<T, N>(o, d, init, lam, 1.0, time, pixel, index);
     if MEDIA {
         st.medium[0] = camera_medium;
         st.in_medium = camera_medium != NO_MEDIUM;
     }
     let pdf_cam = camera.pdf_dir::<MOTION>(time, d);
-    super::run_at(
-        lanes,
-        Walk::<T, N, MOTION, MEDIA, false> {
-            ctx,
-            st: &mut st,
-            path: cam,
-            max: max_depth + 2,
-            pdf_dir: pdf_cam,
-            first_dim: DIM_BOUNCE,
-            stats,
-        },
-    );
+    <f32 as crate::simd::Float>::enter_typed(Walk::<T, N, MOTION, MEDIA, false> {
+        ctx,
+        st: &mut st,
+        path: cam,
+        max: max_depth + 2,
+        pdf_dir: pdf_cam,
+        first_dim: DIM_BOUNCE,
+        stats,
+    });
     // The light subpath.
     let light = &mut paths.light;
     light.clear();
@@ -768,33 +764,27 @@ fn sample<
         }
         light.push(v);
         if max_depth >= 1 {
-            super::run_at(
-                lanes,
-                Walk::<T, N, MOTION, MEDIA, true> {
-                    ctx,
-                    st: &mut st,
-                    path: light,
-                    max: max_depth + 1,
-                    pdf_dir: e.pdf_dir,
-                    first_dim: DIM_LIGHT_PATH + DIMS_PER_BOUNCE,
-                    stats,
-                },
-            );
+            <f32 as crate::simd::Float>::enter_typed(Walk::<T, N, MOTION, MEDIA, true> {
+                ctx,
+                st: &mut st,
+                path: light,
+                max: max_depth + 1,
+                pdf_dir: e.pdf_dir,
+                first_dim: DIM_LIGHT_PATH + DIMS_PER_BOUNCE,
+                stats,
+            });
         }
     }
-    super::run_at(
-        lanes,
-        Joins::<T, N, MOTION, MEDIA> {
-            ctx,
-            camera,
-            which,
-            paths,
-            key: (pixel, index),
-            time,
-            splats,
-            stats,
-        },
-    )
+    <f32 as crate::simd::Float>::enter_typed(Joins::<T, N, MOTION, MEDIA> {
+        ctx,
+        camera,
+        which,
+        paths,
+        key: (pixel, index),
+        time,
+        splats,
+        stats,
+    })
 }
 
 /// A subpath's walk, run inside the width-1 FMA entry point (see [`Joins`]).
@@ -822,11 +812,12 @@ impl<
     const MOTION: bool,
     const MEDIA: bool,
     const LIGHT: bool,
-> crate::simd::LaneKernel for Walk<'_, '_, T, N, MOTION, MEDIA, LIGHT>
+> crate::simd::TypedKernel<f32> for Walk<'_, '_, T, N, MOTION, MEDIA, LIGHT>
 {
     type Output = ();
+    const SHARD: usize = super::home::<T>(MEDIA, MOTION, true);
     #[inline(always)]
-    fn run<F: crate::simd::Float>(self) {
+    fn run(self) {
         walk::<T, N, MOTION, MEDIA, LIGHT>(
             self.ctx,
             self.st,
@@ -842,7 +833,9 @@ impl<
 /// Every strategy of one sample's subpaths, run inside the width-1 FMA entry point: width-1
 /// code outside the lanes' entry points calls libm for each `f32::mul_add`. The walks and
 /// the joins are three entries per sample rather than one, which keeps each function the
-/// compiler optimises of a size it handles quickly.
+/// compiler optimises of a size it handles quickly. They are typed kernels of `f32`, not lane
+/// kernels: a lane kernel is compiled in every lane form `dispatch` knows, six copies where
+/// width 1 runs two.
 struct Joins<'a, 'c, T: Transport, const N: usize, const MOTION: bool, const MEDIA: bool> {
     ctx: &'a Ctx<'c>,
     camera: &'a Camera<'c>,
@@ -855,11 +848,12 @@ struct Joins<'a, 'c, T: Transport, const N: usize, const MOTION: bool, const MED
 }
 
 impl<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool, const MEDIA: bool>
-    crate::simd::LaneKernel for Joins<'_, '_, T, N, MOTION, MEDIA>
+    crate::simd::TypedKernel<f32> for Joins<'_, '_, T, N, MOTION, MEDIA>
 {
     type Output = Vec3;
+    const SHARD: usize = super::home::<T>(MEDIA, MOTION, true);
     #[inline(always)]
-    fn run<F: crate::simd::Float>(self) -> Vec3 {
+    fn run(self) -> Vec3 {
         joins::<T, N, MOTION, MEDIA>(
             self.ctx,
             self.camera,

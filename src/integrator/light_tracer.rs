@@ -930,7 +930,6 @@ pub(super) fn render<
     progress: &dyn Observer,
 ) -> RenderOutput {
     let camera = Camera::new(ctx);
-    let lanes = crate::simd::Lanes::scalar();
     // MEDIA: the shapes that hold a medium, where a light path's start is looked up.
     let holders = if MEDIA {
         ctx.scene.prims.medium_holders()
@@ -948,7 +947,7 @@ pub(super) fn render<
             stats,
             transport: PhantomData,
         };
-        super::run_at(lanes, job)
+        <f32 as crate::simd::Float>::enter_typed(job)
     })
 }
 
@@ -967,11 +966,12 @@ struct TileJob<'a, 'c, 'w, T, const N: usize, const MOTION: bool, const MEDIA: b
 }
 
 impl<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool, const MEDIA: bool>
-    crate::simd::LaneKernel for TileJob<'_, '_, '_, T, N, MOTION, MEDIA>
+    crate::simd::TypedKernel<f32> for TileJob<'_, '_, '_, T, N, MOTION, MEDIA>
 {
     type Output = ();
+    const SHARD: usize = super::home::<T>(MEDIA, MOTION, true);
     #[inline(always)]
-    fn run<F: crate::simd::Float>(self) {
+    fn run(self) {
         trace_tile::<T, N, MOTION, MEDIA>(
             self.ctx,
             self.camera,

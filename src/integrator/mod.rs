@@ -330,6 +330,7 @@ impl<
 > crate::simd::LaneKernel for TileKernel<'_, '_, T, N, MOTION, MEDIA>
 {
     type Output = ();
+    const SHARD: usize = home::<T>(MEDIA, MOTION, false);
     #[inline(always)]
     fn run<F: crate::simd::Float>(self) {
         let tile = self.film.tile;
@@ -388,6 +389,17 @@ fn uniform_passes(
         }
     }
     (done, false)
+}
+
+/// The codegen home of a kernel variant (see [`crate::simd::LaneKernel::SHARD`]): one per
+/// effect set, the path tracer's in the first half of the homes and the splatting
+/// estimators' in the second, so that variants of similar size compile in parallel.
+pub(super) const fn home<T: transport::Transport>(
+    media: bool,
+    motion: bool,
+    splats: bool,
+) -> usize {
+    8 * splats as usize + 4 * T::SPECTRAL as usize + 2 * media as usize + motion as usize
 }
 
 /// Runs a tile kernel at `lanes`.

@@ -553,10 +553,21 @@ impl Lanes {
     }
 }
 
+/// How many codegen homes the entry points have: see [`LaneKernel::SHARD`].
+pub const SHARDS: usize = 16;
+
 /// A computation generic over the lane type, run by [`dispatch`] at one width.
 pub trait LaneKernel {
     /// What the kernel returns.
     type Output;
+    /// Which of the [`SHARDS`] copies of the entry points runs the kernel. The compiler
+    /// places every instance of a generic function in the codegen unit of the module that
+    /// defines it, so with one set of entry points every kernel variant (effects × lane
+    /// forms) would be optimised in one unit, on one core, at the end of the build. Variants
+    /// of similar size with different shards compile in parallel; the code is the same. Less
+    /// than [`SHARDS`]: a `match` on the constant itself (no arithmetic) is what lets the
+    /// compiler instantiate the one home's entry points rather than all of them.
+    const SHARD: usize = 0;
     /// Mark `#[inline(always)]`: see the module docs.
     fn run<F: Float>(self) -> Self::Output;
 }
@@ -566,30 +577,59 @@ pub trait LaneKernel {
 pub trait TypedKernel<F> {
     /// What the work returns.
     type Output;
+    /// As [`LaneKernel::SHARD`].
+    const SHARD: usize = 0;
     /// Mark `#[inline(always)]`, so the work is compiled inside the entry point.
     fn run(self) -> Self::Output;
 }
 
-/// Runs `k` instantiated at the lane type of `lanes`, inside an entry point compiled for that
-/// width's instruction set.
-pub fn dispatch<K: LaneKernel>(lanes: Lanes, k: K) -> K::Output {
-    match lanes.0 {
-        Form::Scalar => k.run::<f32>(),
-        Form::Portable8 => k.run::<PortableF32<8>>(),
-        Form::Portable16 => k.run::<PortableF32<16>>(),
-        // SAFETY: a `Lanes` naming a native form is built only by `Lanes::scalar`,
-        // `native8` and `native16` after `is_x86_feature_detected!` found every feature the
-        // entry point enables.
-        #[cfg(target_arch = "x86_64")]
-        Form::ScalarFma => unsafe { x86::entry_fma(k) },
-        #[cfg(target_arch = "x86_64")]
-        // SAFETY: as above.
-        Form::Avx2 => unsafe { x86::entry_avx2(k) },
-        #[cfg(target_arch = "x86_64")]
-        // SAFETY: as above.
-        Form::Avx512 => unsafe { x86::entry_avx512(k) },
-    }
+/// The dispatch of each codegen home (see [`LaneKernel::SHARD`]), out of line so that the
+/// kernels it inlines compile in that home.
+macro_rules! homes {
+    ($($i:literal => $home:ident),* $(,)?) => {
+        $(
+            mod $home {
+                use super::{Form, LaneKernel, PortableF32};
+
+                #[inline(never)]
+                pub(super) fn run<K: LaneKernel>(form: Form, k: K) -> K::Output {
+                    match form {
+                        Form::Scalar => k.run::<f32>(),
+                        Form::Portable8 => k.run::<PortableF32<8>>(),
+                        Form::Portable16 => k.run::<PortableF32<16>>(),
+                        // SAFETY: a `Lanes` naming a native form is built only by
+                        // `Lanes::scalar`, `native8` and `native16` after
+                        // `is_x86_feature_detected!` found every feature the entry point
+                        // enables.
+                        #[cfg(target_arch = "x86_64")]
+                        Form::ScalarFma => unsafe { super::x86::$home::entry_fma(k) },
+                        #[cfg(target_arch = "x86_64")]
+                        // SAFETY: as above.
+                        Form::Avx2 => unsafe { super::x86::$home::entry_avx2(k) },
+                        #[cfg(target_arch = "x86_64")]
+                        // SAFETY: as above.
+                        Form::Avx512 => unsafe { super::x86::$home::entry_avx512(k) },
+                    }
+                }
+            }
+        )*
+
+        /// Runs `k` instantiated at the lane type of `lanes`, inside an entry point compiled
+        /// for that width's instruction set.
+        pub fn dispatch<K: LaneKernel>(lanes: Lanes, k: K) -> K::Output {
+            match K::SHARD {
+                $($i => $home::run(lanes.0, k),)*
+                _ => unreachable!(),
+            }
+        }
+    };
 }
+
+homes!(
+    0 => home0, 1 => home1, 2 => home2, 3 => home3, 4 => home4, 5 => home5, 6 => home6,
+    7 => home7, 8 => home8, 9 => home9, 10 => home10, 11 => home11, 12 => home12,
+    13 => home13, 14 => home14, 15 => home15,
+);
 
 #[cfg(test)]
 mod tests {

@@ -13,49 +13,130 @@ use std::ops::{
     MulAssign, Neg, Not, Sub, SubAssign,
 };
 
-/// Width 1 compiled with hardware FMA: the same bits as plain scalar code.
-#[target_feature(enable = "fma")]
-pub(super) fn entry_fma<K: LaneKernel>(k: K) -> K::Output {
-    k.run::<f32>()
+/// The entry points, once in each codegen home (see [`LaneKernel::SHARD`]). Each is
+/// `#[target_feature]`, so a kernel it inlines is compiled for that instruction set.
+macro_rules! homes {
+    ($($i:literal => $home:ident),* $(,)?) => {
+        $(
+            pub(super) mod $home {
+                use super::{F16, F8};
+                use crate::simd::{LaneKernel, TypedKernel};
+
+                /// Width 1 compiled with hardware FMA: the same bits as plain scalar code.
+                #[target_feature(enable = "fma")]
+                pub(in crate::simd) fn entry_fma<K: LaneKernel>(k: K) -> K::Output {
+                    k.run::<f32>()
+                }
+
+                #[target_feature(enable = "avx2,fma")]
+                pub(in crate::simd) fn entry_avx2<K: LaneKernel>(k: K) -> K::Output {
+                    k.run::<F8>()
+                }
+
+                #[target_feature(enable = "avx512f,avx512bw,avx2,fma")]
+                pub(in crate::simd) fn entry_avx512<K: LaneKernel>(k: K) -> K::Output {
+                    k.run::<F16>()
+                }
+
+                #[target_feature(enable = "fma")]
+                pub(super) fn entry_fma_typed<K: TypedKernel<f32>>(k: K) -> K::Output {
+                    k.run()
+                }
+
+                /// Width 1 without FMA, out of line so that it too compiles in this home.
+                #[inline(never)]
+                pub(super) fn plain_typed<K: TypedKernel<f32>>(k: K) -> K::Output {
+                    k.run()
+                }
+
+                #[target_feature(enable = "avx2,fma")]
+                pub(super) fn entry_avx2_typed<K: TypedKernel<F8>>(k: K) -> K::Output {
+                    k.run()
+                }
+
+                #[target_feature(enable = "avx512f,avx512bw,avx2,fma")]
+                pub(super) fn entry_avx512_typed<K: TypedKernel<F16>>(k: K) -> K::Output {
+                    k.run()
+                }
+            }
+        )*
+
+        /// [`Float::enter`] at width 8, in the kernel's home.
+        ///
+        /// # Safety
+        /// The CPU has AVX2 and FMA.
+        #[inline(always)]
+        unsafe fn entry_avx2<K: LaneKernel>(k: K) -> K::Output {
+            match K::SHARD {
+                // SAFETY: the caller's.
+                $($i => unsafe { $home::entry_avx2(k) },)*
+                _ => unreachable!(),
+            }
+        }
+
+        /// [`Float::enter`] at width 16, in the kernel's home.
+        ///
+        /// # Safety
+        /// The CPU has AVX-512F/BW, AVX2 and FMA.
+        #[inline(always)]
+        unsafe fn entry_avx512<K: LaneKernel>(k: K) -> K::Output {
+            match K::SHARD {
+                // SAFETY: the caller's.
+                $($i => unsafe { $home::entry_avx512(k) },)*
+                _ => unreachable!(),
+            }
+        }
+
+        /// [`Float::enter_typed`] at width 8, in the kernel's home.
+        ///
+        /// # Safety
+        /// The CPU has AVX2 and FMA.
+        #[inline(always)]
+        unsafe fn entry_avx2_typed<K: TypedKernel<F8>>(k: K) -> K::Output {
+            match K::SHARD {
+                // SAFETY: the caller's.
+                $($i => unsafe { $home::entry_avx2_typed(k) },)*
+                _ => unreachable!(),
+            }
+        }
+
+        /// [`Float::enter_typed`] at width 16, in the kernel's home.
+        ///
+        /// # Safety
+        /// The CPU has AVX-512F/BW, AVX2 and FMA.
+        #[inline(always)]
+        unsafe fn entry_avx512_typed<K: TypedKernel<F16>>(k: K) -> K::Output {
+            match K::SHARD {
+                // SAFETY: the caller's.
+                $($i => unsafe { $home::entry_avx512_typed(k) },)*
+                _ => unreachable!(),
+            }
+        }
+
+        /// Width 1's [`Float::enter_typed`]: the FMA entry where the CPU has FMA (its `mul_add`
+        /// is then one instruction, not a call into libm; both round once, so the bits are the
+        /// same), in the kernel's home.
+        #[inline(always)]
+        pub(super) fn enter_scalar_typed<K: TypedKernel<f32>>(k: K) -> K::Output {
+            let fma = is_x86_feature_detected!("fma");
+            match K::SHARD {
+                $($i => if fma {
+                    // SAFETY: FMA, all the entry enables, was just detected.
+                    unsafe { $home::entry_fma_typed(k) }
+                } else {
+                    $home::plain_typed(k)
+                },)*
+                _ => unreachable!(),
+            }
+        }
+    };
 }
 
-#[target_feature(enable = "avx2,fma")]
-pub(super) fn entry_avx2<K: LaneKernel>(k: K) -> K::Output {
-    k.run::<F8>()
-}
-
-#[target_feature(enable = "avx512f,avx512bw,avx2,fma")]
-pub(super) fn entry_avx512<K: LaneKernel>(k: K) -> K::Output {
-    k.run::<F16>()
-}
-
-/// [`entry_fma`] for work over lanes of one type: see [`Float::enter_typed`].
-#[target_feature(enable = "fma")]
-fn entry_fma_typed<K: TypedKernel<f32>>(k: K) -> K::Output {
-    k.run()
-}
-
-#[target_feature(enable = "avx2,fma")]
-fn entry_avx2_typed<K: TypedKernel<F8>>(k: K) -> K::Output {
-    k.run()
-}
-
-#[target_feature(enable = "avx512f,avx512bw,avx2,fma")]
-fn entry_avx512_typed<K: TypedKernel<F16>>(k: K) -> K::Output {
-    k.run()
-}
-
-/// Width 1's [`Float::enter_typed`]: the FMA entry where the CPU has FMA (its `mul_add` is
-/// then one instruction, not a call into libm; both round once, so the bits are the same).
-#[inline(always)]
-pub(super) fn enter_scalar_typed<K: TypedKernel<f32>>(k: K) -> K::Output {
-    if is_x86_feature_detected!("fma") {
-        // SAFETY: FMA, all the entry enables, was just detected.
-        unsafe { entry_fma_typed(k) }
-    } else {
-        k.run()
-    }
-}
+homes!(
+    0 => home0, 1 => home1, 2 => home2, 3 => home3, 4 => home4, 5 => home5, 6 => home6,
+    7 => home7, 8 => home8, 9 => home9, 10 => home10, 11 => home11, 12 => home12,
+    13 => home13, 14 => home14, 15 => home15,
+);
 
 /// Binary operator traits from one intrinsic each.
 macro_rules! binops {
