@@ -548,15 +548,7 @@ impl Primitives {
     /// [`Self::medium_at`] over `holders` ([`Self::medium_holders`]) alone: no pass over
     /// every primitive.
     pub fn medium_among(&self, p: Vec3, holders: &[u32]) -> u32 {
-        let mut best = (f32::INFINITY, NO_MEDIUM);
-        for &i in holders {
-            if let Some(v) = self.contains(i, p)
-                && v < best.0
-            {
-                best = (v, self.medium_inside[i as usize]);
-            }
-        }
-        best.1
+        self.smallest_medium(p, holders.iter().copied())
     }
 
     /// The medium at point `p`: that of the smallest medium shape containing it.
@@ -565,11 +557,16 @@ impl Primitives {
     }
 
     pub(crate) fn medium_at_excluding(&self, p: Vec3, skip: Option<u32>) -> u32 {
+        let holders = (0..self.len() as u32)
+            .filter(|&i| Some(i) != skip && self.medium_inside[i as usize] != NO_MEDIUM);
+        self.smallest_medium(p, holders)
+    }
+
+    /// The medium inside the smallest of `holders` (medium-holding primitives) that contains
+    /// `p`, or [`NO_MEDIUM`].
+    fn smallest_medium(&self, p: Vec3, holders: impl Iterator<Item = u32>) -> u32 {
         let mut best = (f32::INFINITY, NO_MEDIUM);
-        for i in 0..self.len() as u32 {
-            if Some(i) == skip || self.medium_inside[i as usize] == NO_MEDIUM {
-                continue;
-            }
+        for i in holders {
             if let Some(v) = self.contains(i, p)
                 && v < best.0
             {
