@@ -22,8 +22,11 @@
 //! MEDIA: both subpaths sample their free flight inside a medium; a scattering event there
 //! is a vertex whose phase function connects as a BSDF does (no cosine, its own adjoint), and
 //! every connection carries the transmittance along it, across media's boundaries. The MIS
-//! weights leave the free-flight densities out: weights stay unbiased so long as every
-//! strategy of a path computes the same densities for it.
+//! densities include free flight as a grey medium would sample it (each medium's mean σt):
+//! a strategy that would have to cross a thick stretch of fog by chance weighs less than one
+//! that connects across it. The σt of a vertex in a medium is the same whichever side
+//! generates it and cancels in the ratios; each segment's transmittance stays. Weights are
+//! unbiased with any densities so long as every strategy of a path computes the same ones.
 
 use super::bsdf::{Frame, LaneChannels, Mode};
 use super::ctx::{Ctx, DIM_BOUNCE, DIM_MEDIA, DIMS_PER_BOUNCE};
@@ -34,7 +37,7 @@ use super::media::Flight;
 use super::microfacet::RoughDielectric;
 use super::state::{C, M, MAX_W, Paths, U};
 use super::surface::{CLASS_BOUNDARY, CLASS_NONE, Surface};
-use super::transport::{ChannelArray, Transport};
+use super::transport::{ChannelArray, MediumOps, Transport};
 use super::{Observer, RenderOptions, RenderOutput, RenderStats};
 use crate::components::Material;
 use crate::film::{Tile, TileWork};
@@ -116,6 +119,9 @@ struct Vtx<T: Transport, const N: usize> {
     /// next (reverse), as the subpath's own sampling would.
     fwd: f32,
     rev: f32,
+    /// MEDIA: the probability, in the MIS densities, that a free flight crosses the segment
+    /// from the previous vertex to this one ([`passes`]); 1 at a subpath's start.
+    pass: f32,
     /// The BSDF sampled a delta lobe here.
     delta: bool,
     /// The BSDF or phase function at a vertex with a density (one that connects).
@@ -151,6 +157,7 @@ impl<T: Transport, const N: usize> Vtx<T, N> {
             lam,
             fwd,
             rev: 0.0,
+            pass: 1.0,
             delta: false,
             bsdf: None,
             medium: NO_MEDIUM,
@@ -374,6 +381,62 @@ fn density<T: Transport, const N: usize>(pdf: f32, from: &Vtx<T, N>, to: &Vtx<T,
     pdf * cos_to(d / r2.sqrt()) / r2
 }
 
+/// MEDIA: the extinction with which the MIS densities follow medium `m`'s free flight: the
+/// mean of its σt over the RGB channels. The sampler's own channel mixture depends on each
+/// path's throughput, which a reverse density does not know; a grey stand-in is exact for
+/// grey media and the same for every strategy.
+#[inline(always)]
+fn mis_extinction(ctx: &Ctx, m: u32) -> f32 {
+    ctx.scene.prims.media[m as usize].sigma_t().element_sum() * (1.0 / 3.0)
+}
+
+/// The probability, in the MIS densities, of a free flight crossing a segment of grey
+/// optical depth `depth`; 1 without MEDIA.
+#[inline(always)]
+fn passes<const MEDIA: bool>(depth: f32) -> f32 {
+    if MEDIA { (-depth).exp() } else { 1.0 }
+}
+
+/// MEDIA: the transmittance along `ray` up to `t_max` as [`super::light_tracer::transmittance`]
+/// gives it, with the segment's grey optical depth (zero without MEDIA).
+#[inline(always)]
+fn transmittance<
+    T: Transport<S: ChannelArray<N>>,
+    const N: usize,
+    const MOTION: bool,
+    const MEDIA: bool,
+>(
+    ctx: &Ctx,
+    ray: &Ray,
+    t_max: f32,
+    medium: u32,
+    time: f32,
+    lam: &T::Lanes<f32>,
+) -> Option<(C<f32, N>, f32)> {
+    if !MEDIA {
+        let tr = super::light_tracer::transmittance::<T, N, MOTION, false>;
+        return tr(ctx, ray, t_max, medium, time, lam).map(|c| (c, 0.0));
+    }
+    let lam = T::lane(lam, 0);
+    let depth = std::cell::Cell::new(0.0f32);
+    let tr: T::S = ctx.scene.transmittance_with::<MOTION, T::S>(
+        ray,
+        t_max,
+        time,
+        medium,
+        #[inline(always)]
+        |m, d| {
+            // An unbounded stretch in a medium transmits nothing: the connection is dropped.
+            if d.is_finite() {
+                depth.set(depth.get() + mis_extinction(ctx, m) * d);
+            }
+            T::medium(ctx, m, &lam).transmittance(d)
+        },
+    );
+    let c = super::bsdf::Chan(tr.to_array());
+    (!c.is_zero()).then_some((c, depth.get()))
+}
+
 /// The ray from `a` to `b` (at parameter 1), each end offset off its surface (`na`, `nb`;
 /// zero at the lens, at a point light and in a medium), and the parameter it stops at.
 #[inline(always)]
@@ -488,6 +551,9 @@ fn walk<
     stats: &mut RenderStats,
 ) {
     let scene = ctx.scene;
+    // MEDIA: the grey optical depth of the segment since the last vertex, across boundaries;
+    // its transmittance enters both densities of the segment.
+    let mut depth = 0.0f32;
     while st.alive && path.len() < max {
         stats.rays += 1;
         stats.lane_slots += 1;
@@ -495,18 +561,26 @@ fn walk<
         let prev = path.len() - 1;
         if MEDIA && st.in_medium {
             let base = if LIGHT { DIM_LIGHT_MEDIA } else { DIM_MEDIA };
+            let sigma = mis_extinction(ctx, st.medium[0]);
             match super::media::flight(ctx, st, &hits, base) {
-                Flight::Passes => {}
+                Flight::Passes => {
+                    if hits.hit {
+                        depth += sigma * hits.t;
+                    }
+                }
                 Flight::Ends => break,
-                Flight::Scatters { p, g, dim } => {
+                Flight::Scatters { p, t, g, dim } => {
                     // A vertex in the medium.
+                    depth += sigma * t;
+                    let pass = passes::<MEDIA>(depth);
                     let wo = -st.d.lane(0);
                     let mut v = Vtx {
                         wo,
                         medium: st.medium[0],
+                        pass,
                         ..Vtx::<T, N>::start(p, false, Vec3::ZERO, st.beta, st.lam, 0.0, dim + 2)
                     };
-                    v.fwd = density(pdf_dir, &path[prev], &v);
+                    v.fwd = density(pdf_dir, &path[prev], &v) * pass;
                     if LIGHT || path.len() + 1 < max {
                         v.bsdf = Some(Scatter::Phase(g));
                     }
@@ -516,7 +590,8 @@ fn walk<
                     }
                     // The phase function is symmetric: the reverse density is the forward one.
                     pdf_dir = super::media::scatter_phase(ctx, st, p, g, dim);
-                    path[prev].rev = density(pdf_dir, &path[prev + 1], &path[prev]);
+                    path[prev].rev = density(pdf_dir, &path[prev + 1], &path[prev]) * pass;
+                    depth = 0.0;
                     continue;
                 }
             }
@@ -529,6 +604,10 @@ fn walk<
                 let p = st.d.lane(0).normalize();
                 let mut v = Vtx::<T, N>::start(p, true, Vec3::ZERO, st.beta, st.lam, 0.0, dim);
                 v.fwd = density(pdf_dir, &path[prev], &v);
+                if MEDIA {
+                    v.pass = passes::<MEDIA>(depth);
+                    v.fwd *= v.pass;
+                }
                 path.push(v);
             }
             break;
@@ -546,6 +625,10 @@ fn walk<
             ..Vtx::<T, N>::start(p, false, ng, st.beta, st.lam, 0.0, dim)
         };
         v.fwd = density(pdf_dir, &path[prev], &v);
+        if MEDIA {
+            v.pass = passes::<MEDIA>(depth);
+            v.fwd *= v.pass;
+        }
         if sf.class == CLASS_NONE {
             // Emitters absorb. The camera subpath keeps the hit for strategy s = 0.
             if !LIGHT && sf.emits {
@@ -607,6 +690,10 @@ fn walk<
             break;
         }
         path[prev].rev = density(rev, &path[prev + 1], &path[prev]);
+        if MEDIA {
+            path[prev].rev *= path[prev + 1].pass;
+            depth = 0.0;
+        }
     }
 }
 
@@ -975,7 +1062,7 @@ fn emitter_hit<T: Transport<S: ChannelArray<N>>, const N: usize>(
     let pdf_dir = area_emission_pdf(prims, prims.material[prim as usize], pt.ng, pt.wo);
     let rev = Rev {
         pt: pmf / area,
-        pt_minus: density(pdf_dir, pt, prev),
+        pt_minus: density(pdf_dir, pt, prev) * pt.pass,
         qs: 0.0,
         qs_minus: 0.0,
     };
@@ -1024,9 +1111,10 @@ fn environment_hit<T: Transport<S: ChannelArray<N>>, const N: usize>(
         let w = if !weighted || t == 2 {
             1.0
         } else {
+            let disc = ctx.scene.lights.disc_density();
             let rev = Rev {
                 pt: pdf,
-                pt_minus: density(ctx.scene.lights.disc_density(), pt, &cam[t - 2]),
+                pt_minus: density(disc, pt, &cam[t - 2]) * pt.pass,
                 qs: 0.0,
                 qs_minus: 0.0,
             };
@@ -1068,8 +1156,11 @@ fn light_to_camera<
     }
     stats.shadow_rays += 1;
     let m = medium_toward(ctx, qs, conn.wc);
-    let seen = Camera::seen_from::<T, N, MOTION, MEDIA>;
-    c = c * seen(camera, ctx, qs.p, qs.ng, &conn, m, time, &qs.lam)?;
+    // The lens lies on no surface: stop just short of it (as `Camera::seen_from`).
+    let ray = camera.ray_from(qs.p, qs.ng, &conn);
+    let (tr, depth) =
+        transmittance::<T, N, MOTION, MEDIA>(ctx, &ray, 1.0 - 1e-4, m, time, &qs.lam)?;
+    c = c * tr;
     let lam = joined::<T, N>(&qs.lam, &cam[0].lam, &mut c);
     if weighted {
         let prev = &light[s - 2];
@@ -1078,8 +1169,8 @@ fn light_to_camera<
         let rev = Rev {
             pt: 0.0,
             pt_minus: 0.0,
-            qs: conn.importance * cosine(qs.ng, conn.wc),
-            qs_minus: density(bsdf.pdf(conn.wc, qs.wo), qs, prev),
+            qs: conn.importance * cosine(qs.ng, conn.wc) * passes::<MEDIA>(depth),
+            qs_minus: density(bsdf.pdf(conn.wc, qs.wo), qs, prev) * qs.pass,
         };
         c = c * mis_weight(cam, light, s, 1, &rev, delta_light_of(light));
     }
@@ -1137,18 +1228,19 @@ fn connect<
     stats.shadow_rays += 1;
     let m = medium_toward(ctx, pt, w);
     let (ray, t_max) = segment_ray(pt.p, pt.ng, qs.p, qs.ng);
-    let tr = super::light_tracer::transmittance::<T, N, MOTION, MEDIA>;
-    c = c * tr(ctx, &ray, t_max, m, time, &pt.lam)?;
+    let (tr, depth) = transmittance::<T, N, MOTION, MEDIA>(ctx, &ray, t_max, m, time, &pt.lam)?;
+    c = c * tr;
     let lam = joined::<T, N>(&pt.lam, &qs.lam, &mut c);
     if !weighted {
         return Some((c, lam));
     }
     let cp = &cam[t - 2];
+    let across = passes::<MEDIA>(depth);
     let rev = Rev {
-        pt: density(pdf_l, qs, pt),
-        pt_minus: density(bc.pdf(w, pt.wo), pt, cp),
-        qs: density(pdf_c, pt, qs),
-        qs_minus: density(bl.pdf(-w, qs.wo), qs, &light[s - 2]),
+        pt: density(pdf_l, qs, pt) * across,
+        pt_minus: density(bc.pdf(w, pt.wo), pt, cp) * pt.pass,
+        qs: density(pdf_c, pt, qs) * across,
+        qs_minus: density(bl.pdf(-w, qs.wo), qs, &light[s - 2]) * qs.pass,
     };
     let weight = mis_weight(cam, light, s, t, &rev, delta_light_of(light));
     Some((c * weight, lam))
@@ -1204,16 +1296,17 @@ fn light_sample<
         }
     };
     let m = medium_toward(ctx, pt, w);
-    let tr = super::light_tracer::transmittance::<T, N, MOTION, MEDIA>;
-    c = c * tr(ctx, &ray, t_max, m, time, &pt.lam)?;
+    let (tr, depth) = transmittance::<T, N, MOTION, MEDIA>(ctx, &ray, t_max, m, time, &pt.lam)?;
+    c = c * tr;
     if !weighted {
         return Some((c, pt.lam));
     }
     let (qs, pdf_l) = light_start::<T, N>(ctx, &ls, pt)?;
+    let across = passes::<MEDIA>(depth);
     let rev = Rev {
-        pt: density(pdf_l, &qs, pt),
-        pt_minus: density(bc.pdf(w, pt.wo), pt, &cam[t - 2]),
-        qs: density(pdf_c, pt, &qs),
+        pt: density(pdf_l, &qs, pt) * across,
+        pt_minus: density(bc.pdf(w, pt.wo), pt, &cam[t - 2]) * pt.pass,
+        qs: density(pdf_c, pt, &qs) * across,
         qs_minus: 0.0,
     };
     let weight = mis_weight(cam, std::slice::from_ref(&qs), 1, t, &rev, ls.delta);

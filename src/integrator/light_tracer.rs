@@ -876,7 +876,7 @@ fn trace_tile<
                     match super::media::flight(ctx, &mut st, &hits, DIM_MEDIA) {
                         Flight::Passes => {}
                         Flight::Ends => break,
-                        Flight::Scatters { p, g, dim } => {
+                        Flight::Scatters { p, g, dim, .. } => {
                             vertex.medium_vertex::<T, N, MOTION>(ctx, &st, (p, g, dim), stats);
                             super::media::scatter_phase(ctx, &mut st, p, g, dim);
                             continue;

@@ -432,10 +432,10 @@ pub(super) enum Flight {
     Passes,
     /// No throughput is left: the path ends.
     Ends,
-    /// It scatters at `p`, in a medium of asymmetry `g`; the event's dimensions are the
-    /// segment's block from `dim` (the light choice and the lens point at 2 to 4, as
-    /// [`free_flight`]'s light samples take them).
-    Scatters { p: Vec3, g: f32, dim: u32 },
+    /// It scatters at `p`, at distance `t` along the ray, in a medium of asymmetry `g`; the
+    /// event's dimensions are the segment's block from `dim` (the light choice and the lens
+    /// point at 2 to 4, as [`free_flight`]'s light samples take them).
+    Scatters { p: Vec3, t: f32, g: f32, dim: u32 },
 }
 
 /// Width 1: samples the free flight of the path `st`, inside a medium, towards `hits`, its
@@ -466,7 +466,12 @@ pub(super) fn flight<T: Transport<S: ChannelArray<N>>, const N: usize>(
         Flight::Ends
     } else if ff.scatter {
         let p = st.o.lane(0) + st.d.lane(0) * ff.t;
-        Flight::Scatters { p, g: med.g(), dim }
+        Flight::Scatters {
+            p,
+            t: ff.t,
+            g: med.g(),
+            dim,
+        }
     } else {
         Flight::Passes
     }

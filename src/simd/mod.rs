@@ -617,6 +617,8 @@ macro_rules! homes {
         /// Runs `k` instantiated at the lane type of `lanes`, inside an entry point compiled
         /// for that width's instruction set.
         pub fn dispatch<K: LaneKernel>(lanes: Lanes, k: K) -> K::Output {
+            // A home past the last is refused when the kernel is compiled.
+            const { assert!(K::SHARD < SHARDS) };
             match K::SHARD {
                 $($i => $home::run(lanes.0, k),)*
                 _ => unreachable!(),

@@ -67,6 +67,8 @@ macro_rules! homes {
         /// The CPU has AVX2 and FMA.
         #[inline(always)]
         unsafe fn entry_avx2<K: LaneKernel>(k: K) -> K::Output {
+            // A home past the last is refused when the kernel is compiled.
+            const { assert!(K::SHARD < super::SHARDS) };
             match K::SHARD {
                 // SAFETY: the caller's.
                 $($i => unsafe { $home::entry_avx2(k) },)*
@@ -80,6 +82,8 @@ macro_rules! homes {
         /// The CPU has AVX-512F/BW, AVX2 and FMA.
         #[inline(always)]
         unsafe fn entry_avx512<K: LaneKernel>(k: K) -> K::Output {
+            // A home past the last is refused when the kernel is compiled.
+            const { assert!(K::SHARD < super::SHARDS) };
             match K::SHARD {
                 // SAFETY: the caller's.
                 $($i => unsafe { $home::entry_avx512(k) },)*
@@ -93,6 +97,8 @@ macro_rules! homes {
         /// The CPU has AVX2 and FMA.
         #[inline(always)]
         unsafe fn entry_avx2_typed<K: TypedKernel<F8>>(k: K) -> K::Output {
+            // A home past the last is refused when the kernel is compiled.
+            const { assert!(K::SHARD < super::SHARDS) };
             match K::SHARD {
                 // SAFETY: the caller's.
                 $($i => unsafe { $home::entry_avx2_typed(k) },)*
@@ -106,6 +112,8 @@ macro_rules! homes {
         /// The CPU has AVX-512F/BW, AVX2 and FMA.
         #[inline(always)]
         unsafe fn entry_avx512_typed<K: TypedKernel<F16>>(k: K) -> K::Output {
+            // A home past the last is refused when the kernel is compiled.
+            const { assert!(K::SHARD < super::SHARDS) };
             match K::SHARD {
                 // SAFETY: the caller's.
                 $($i => unsafe { $home::entry_avx512_typed(k) },)*
@@ -119,6 +127,8 @@ macro_rules! homes {
         #[inline(always)]
         pub(super) fn enter_scalar_typed<K: TypedKernel<f32>>(k: K) -> K::Output {
             let fma = is_x86_feature_detected!("fma");
+            // A home past the last is refused when the kernel is compiled.
+            const { assert!(K::SHARD < super::SHARDS) };
             match K::SHARD {
                 $($i => if fma {
                     // SAFETY: FMA, all the entry enables, was just detected.
