@@ -98,8 +98,9 @@ pub(super) struct RenderArgs {
     #[arg(long, conflicts_with = "sample_offset")]
     pub(super) batch: Option<u32>,
     /// Render until the image's estimated relative MSE is at most T (in (0, 1], e.g. 0.01),
-    /// spending samples where the noise is; --spp (the most any pixel gets) and --time-limit
-    /// cap it. Overrides render.target_error.
+    /// spending samples where the noise is (Bdpt and LightTracing: the same count for every
+    /// pixel); --spp (the most any pixel gets) and --time-limit cap it. Overrides
+    /// render.target_error.
     #[arg(long, value_name = "T", allow_negative_numbers = true)]
     pub(super) target_error: Option<f64>,
     /// PNG exposure in stops.

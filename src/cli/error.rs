@@ -55,9 +55,6 @@ pub enum CliError {
     /// `Effects::force`).
     #[error("{0}")]
     Force(String),
-    /// The scene asks for an estimator that cannot render it (the reason says why).
-    #[error("render.integrator.kind: {0}")]
-    Estimator(String),
     /// A study (`converge`, `costs`) failed; the message is the study's own.
     #[error("{0}")]
     Report(String),

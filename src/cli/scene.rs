@@ -4,7 +4,6 @@
 use super::CliError;
 use crate::kdtree::KdParams;
 use crate::scene::{Effect, RenderScene};
-use crate::scene_file::schema::Estimator;
 use crate::scene_file::{self, LoadedScene};
 use crate::systems;
 use std::path::Path;
@@ -28,13 +27,6 @@ pub(super) fn prepare(
 ) -> Result<RenderScene, CliError> {
     let mut rs = systems::prepare_frame(scene, &KdParams::default(), frame);
     force_effects(&mut rs, force)?;
-    let kind = rs.settings.kind;
-    // `Auto` takes the path tracer for a target error.
-    if kind != Estimator::Path && kind != Estimator::Auto && rs.settings.target_error.is_some() {
-        return Err(CliError::Estimator(format!(
-            "{kind:?} renders a fixed number of samples; a target error needs Path"
-        )));
-    }
     Ok(rs)
 }
 

@@ -758,6 +758,7 @@ fn trace_tile<
             let (index, half) = work.index(first + k);
             let pixel = (y * ctx.width + x) | half;
             stats.samples += 1;
+            splats.half_b = half != 0;
             let rgb = sample::<T, N, MOTION, MEDIA>(
                 ctx, camera, which, holders, &mut paths, x, y, pixel, index, splats, stats,
             );
@@ -1394,9 +1395,6 @@ pub fn choose(scene: &RenderScene) -> (Estimator, String) {
     let kind = scene.settings.kind;
     if kind != Estimator::Auto {
         return (kind, "render.integrator.kind".into());
-    }
-    if scene.settings.target_error.is_some() {
-        return (Estimator::Path, "Auto: a target error needs Path".into());
     }
     if scene.lights.lights.is_empty() {
         return (Estimator::Path, "Auto: the scene has no light".into());

@@ -50,6 +50,11 @@ pub(super) struct Splats {
     width: u32,
     height: u32,
     sums: Vec<[i64; 3]>,
+    /// With a target error, the sums of the samples of half B alone (see
+    /// [`crate::film::estimate`]); empty otherwise.
+    half: Vec<[i64; 3]>,
+    /// The sample being traced belongs to half B: what it adds goes to `half` too.
+    pub(super) half_b: bool,
 }
 
 impl Splats {
@@ -58,6 +63,31 @@ impl Splats {
             width,
             height,
             sums: vec![[0; 3]; width as usize * height as usize],
+            half: Vec::new(),
+            half_b: false,
+        }
+    }
+
+    /// An empty film that also keeps the sums of half B.
+    fn with_halves(width: u32, height: u32) -> Self {
+        let mut s = Self::new(width, height);
+        s.half = s.sums.clone();
+        s
+    }
+
+    /// Adds `v` (fixed point) to pixel `i`, and to its half B when the sample is of that half.
+    #[inline(always)]
+    fn deposit(&mut self, i: usize, v: [i64; 3]) {
+        let add = |s: &mut [i64; 3]| {
+            for (s, v) in s.iter_mut().zip(v) {
+                *s = s.saturating_add(v);
+            }
+        };
+        add(&mut self.sums[i]);
+        if self.half_b
+            && let Some(h) = self.half.get_mut(i)
+        {
+            add(h);
         }
     }
 
@@ -65,10 +95,8 @@ impl Splats {
     /// importance-sampled).
     #[inline(always)]
     pub(super) fn add_pixel(&mut self, x: u32, y: u32, rgb: Vec3) {
-        let s = &mut self.sums[(y * self.width + x) as usize];
-        for (s, c) in s.iter_mut().zip(rgb.to_array()) {
-            *s = s.saturating_add((f64::from(c) * ONE).round() as i64);
-        }
+        let v = rgb.to_array().map(|c| (f64::from(c) * ONE).round() as i64);
+        self.deposit((y * self.width + x) as usize, v);
     }
 
     /// Adds `rgb` at raster point (`fx`, `fy`) to the pixels whose filter covers it.
@@ -78,11 +106,11 @@ impl Splats {
             if x < 0 || y < 0 || x >= i64::from(self.width) || y >= i64::from(self.height) {
                 return;
             }
-            let s = &mut self.sums[(y * i64::from(self.width) + x) as usize];
-            for (s, c) in s.iter_mut().zip(rgb.to_array()) {
-                // `as` saturates: no splat wraps a sum around.
-                *s = s.saturating_add((f64::from(c * w) * ONE).round() as i64);
-            }
+            // `as` saturates: no splat wraps a sum around.
+            let v = rgb
+                .to_array()
+                .map(|c| (f64::from(c * w) * ONE).round() as i64);
+            self.deposit((y * i64::from(self.width) + x) as usize, v);
         };
         if box_filter {
             put(fx.floor() as i64, fy.floor() as i64, 1.0);
@@ -107,7 +135,21 @@ impl Splats {
                 a[c] = a[c].saturating_add(b[c]);
             }
         }
+        for (a, b) in self.half.iter_mut().zip(&o.half) {
+            for c in 0..3 {
+                a[c] = a[c].saturating_add(b[c]);
+            }
+        }
         self
+    }
+
+    /// Adds the fixed-point sums of `from` to `to` (f64).
+    fn accumulate(to: &mut [[f64; 3]], from: &[[i64; 3]]) {
+        for (s, p) in to.iter_mut().zip(from) {
+            for c in 0..3 {
+                s[c] += p[c] as f64 / ONE;
+            }
+        }
     }
 }
 
@@ -785,6 +827,7 @@ fn trace_tile<
             let (index, half) = work.index(first + k);
             let pixel = (y * ctx.width + x) | half;
             stats.samples += 1;
+            vertex.splats.half_b = half != 0;
             let time = if MOTION {
                 let (open, close) = scene.shutter;
                 open + (close - open) * ctx.sampler.get_1d_lanes::<f32>(pixel, index, DIM_TIME)
@@ -985,7 +1028,8 @@ impl<T: Transport<S: ChannelArray<N>>, const N: usize, const MOTION: bool, const
 }
 
 /// The pass loop of the estimators that splat: `trace` renders the samples a pass names of
-/// one tile into a work item's splats; the items' fixed-point sums are added per pass.
+/// one tile into a work item's splats; the items' fixed-point sums are added per pass. With a
+/// target error, the passes are those of [`target_passes`].
 pub(super) fn splat_passes(
     opts: &RenderOptions,
     ctx: &Ctx,
@@ -995,18 +1039,24 @@ pub(super) fn splat_passes(
 ) -> RenderOutput {
     let scene = ctx.scene;
     let (w, h) = (scene.settings.width, scene.settings.height);
-    let mut sums = vec![[0.0f64; 3]; w as usize * h as usize];
-    let mut stats = RenderStats::default();
-    let start = Instant::now();
     let stopped = || opts.stop.is_some_and(|s| s.load(Ordering::Relaxed));
-    let (done, interrupted) = uniform_passes(opts, w, h, progress, start, |work| {
+    // One pass: every tile's samples that `work` names, each work item's splats merged in
+    // fixed point. `None` if a stop came during it.
+    let pass = |work: &TileWork| -> Option<(Splats, RenderStats)> {
         let result = tiles
             .par_iter()
             .fold(
-                || (Splats::new(w, h), RenderStats::default()),
+                || {
+                    let splats = if work.split {
+                        Splats::with_halves(w, h)
+                    } else {
+                        Splats::new(w, h)
+                    };
+                    (splats, RenderStats::default())
+                },
                 |(mut splats, mut st), tile| {
                     if !stopped() {
-                        trace(tile, &work, &mut splats, &mut st);
+                        trace(tile, work, &mut splats, &mut st);
                         progress.samples(work.total(tile.pixels()));
                     }
                     (splats, st)
@@ -1019,14 +1069,18 @@ pub(super) fn splat_passes(
         if stopped() {
             return None;
         }
-        if let Some((splats, st)) = result {
-            for (s, p) in sums.iter_mut().zip(&splats.sums) {
-                for c in 0..3 {
-                    s[c] += p[c] as f64 / ONE;
-                }
-            }
-            stats.add(&st);
-        }
+        Some(result.unwrap_or_else(|| (Splats::new(w, h), RenderStats::default())))
+    };
+    let start = Instant::now();
+    if let Some(target) = opts.target_error {
+        return target_passes(opts, w, h, progress, start, target, pass);
+    }
+    let mut sums = vec![[0.0f64; 3]; w as usize * h as usize];
+    let mut stats = RenderStats::default();
+    let (done, interrupted) = uniform_passes(opts, w, h, progress, start, |work| {
+        let (splats, st) = pass(&work)?;
+        Splats::accumulate(&mut sums, &splats.sums);
+        stats.add(&st);
         Some(())
     });
     RenderOutput {
@@ -1037,6 +1091,87 @@ pub(super) fn splat_passes(
         counts: Vec::new(),
         half: Vec::new(),
         estimate: None,
+        stats,
+        seconds: start.elapsed().as_secs_f64(),
+        lanes: crate::simd::Lanes::scalar(),
+        interrupted,
+    }
+}
+
+/// The passes of a splatting render to a target error: every pixel takes the same number of
+/// samples, alternating between the two independent halves the estimate needs (a splat lands
+/// in the half of the sample whose light path made it). A light path's splats spread over the
+/// image in proportion to one light path per camera sample, which holds only if every pixel
+/// has the same count: so the counts are uniform, not adaptive. The image's relMSE falls as
+/// 1/spp, so each pass aims at 0.9 of the target from the estimate so far, growing the count
+/// at most 2× a pass (1.25× within twice the target, so the stop does not overshoot).
+fn target_passes(
+    opts: &RenderOptions,
+    w: u32,
+    h: u32,
+    progress: &dyn Observer,
+    start: Instant,
+    target: f64,
+    pass: impl Fn(&TileWork) -> Option<(Splats, RenderStats)>,
+) -> RenderOutput {
+    use crate::film::estimate;
+    let pixels = w as usize * h as usize;
+    let (mut sums, mut half) = (vec![[0.0f64; 3]; pixels], vec![[0.0f64; 3]; pixels]);
+    let mut stats = RenderStats::default();
+    // Even, so both halves always hold as many samples.
+    let cap = opts.spp.max(2) & !1;
+    let (mut done, mut next) = (0u32, super::WARMUP_FIRST.min(cap));
+    let mut estimate = f64::INFINITY;
+    let mut interrupted = false;
+    while next > done {
+        let t_pass = Instant::now();
+        let n = next - done;
+        let work = TileWork {
+            offset: opts.sample_offset,
+            uniform: (done, n),
+            per_pixel: None,
+            split: true,
+        };
+        let Some((splats, st)) = pass(&work) else {
+            interrupted = true;
+            break;
+        };
+        Splats::accumulate(&mut sums, &splats.sums);
+        Splats::accumulate(&mut half, &splats.half);
+        stats.add(&st);
+        done = next;
+        let counts = vec![done; pixels];
+        estimate = estimate::image_error(&estimate::pixel_errors(&sums, &half, &counts, w, h));
+        progress.pass(&super::PassReport {
+            samples: u64::from(done) * pixels as u64,
+            seconds: start.elapsed().as_secs_f64(),
+            estimate: Some(estimate),
+        });
+        if estimate <= target {
+            break;
+        }
+        let growth = if estimate < 2.0 * target { 1.25 } else { 2.0 };
+        let want = f64::from(done) * estimate / (0.9 * target);
+        let want = want.min(f64::from(done) * growth).min(f64::from(cap));
+        // In even steps, rounded down (at a few samples per pixel one step is a large
+        // fraction), and at least one more sample per half.
+        next = ((want as u32) & !1).max(done + 2).min(cap);
+        if let Some(limit) = opts.time_limit {
+            let per_sample = t_pass.elapsed().as_secs_f64() / f64::from(n);
+            let elapsed = start.elapsed().as_secs_f64();
+            if elapsed + per_sample * f64::from(next - done) > limit {
+                break;
+            }
+        }
+    }
+    RenderOutput {
+        width: w,
+        height: h,
+        sums,
+        spp: done,
+        counts: vec![done; pixels],
+        half,
+        estimate: Some(estimate),
         stats,
         seconds: start.elapsed().as_secs_f64(),
         lanes: crate::simd::Lanes::scalar(),

@@ -433,10 +433,10 @@ fn render_with<
     };
     let mut ctx = Ctx::new(scene, scene.effects.has(Effect::Lens)).with_spectral(&spectral);
     ctx.monochromatic = opts.monochromatic;
-    // A render to a target error, set here or in the scene, is path traced: only the path
-    // tracer's passes keep the two halves the estimate needs (the CLI refuses the others).
+    // The splatting estimators render to a target error with uniform counts (see
+    // `light_tracer::target_passes`); only the path tracer's are adaptive.
     let (kind, _) = bdpt::choose(scene);
-    if kind != Estimator::Path && opts.target_error.is_none() {
+    if kind != Estimator::Path {
         let tiles = tiles(scene.settings.width, scene.settings.height);
         if kind == Estimator::LightTracing {
             return light_tracer::render::<T, N, MOTION, MEDIA>(&ctx, opts, &tiles, progress);
