@@ -37,7 +37,7 @@ use super::media::Flight;
 use super::microfacet::RoughDielectric;
 use super::state::{C, M, MAX_W, Paths, U};
 use super::surface::{CLASS_BOUNDARY, CLASS_NONE, Surface};
-use super::transport::{ChannelArray, MediumOps, Transport};
+use super::transport::{ChannelArray, Transport};
 use super::{Observer, RenderOptions, RenderOutput, RenderStats};
 use crate::components::Material;
 use crate::film::{Tile, TileWork};
@@ -397,44 +397,31 @@ fn passes<const MEDIA: bool>(depth: f32) -> f32 {
     if MEDIA { (-depth).exp() } else { 1.0 }
 }
 
-/// MEDIA: the transmittance along `ray` up to `t_max` as [`super::light_tracer::transmittance`]
-/// gives it, with the segment's grey optical depth (zero without MEDIA).
-#[inline(always)]
-fn transmittance<
-    T: Transport<S: ChannelArray<N>>,
-    const N: usize,
-    const MOTION: bool,
-    const MEDIA: bool,
->(
-    ctx: &Ctx,
-    ray: &Ray,
-    t_max: f32,
-    medium: u32,
-    time: f32,
-    lam: &T::Lanes<f32>,
-) -> Option<(C<f32, N>, f32)> {
-    if !MEDIA {
-        let tr = super::light_tracer::transmittance::<T, N, MOTION, false>;
-        return tr(ctx, ray, t_max, medium, time, lam).map(|c| (c, 0.0));
+/// MEDIA: the grey optical depth of the stretches a transmittance query crosses
+/// ([`super::light_tracer::transmittance`]'s `piece`), for the MIS densities.
+struct Depth<'a, 'c> {
+    ctx: &'a Ctx<'c>,
+    sum: std::cell::Cell<f32>,
+}
+
+impl<'a, 'c> Depth<'a, 'c> {
+    #[inline(always)]
+    fn new(ctx: &'a Ctx<'c>) -> Self {
+        Depth {
+            ctx,
+            sum: std::cell::Cell::new(0.0),
+        }
     }
-    let lam = T::lane(lam, 0);
-    let depth = std::cell::Cell::new(0.0f32);
-    let tr: T::S = ctx.scene.transmittance_with::<MOTION, T::S>(
-        ray,
-        t_max,
-        time,
-        medium,
-        #[inline(always)]
-        |m, d| {
-            // An unbounded stretch in a medium transmits nothing: the connection is dropped.
-            if d.is_finite() {
-                depth.set(depth.get() + mis_extinction(ctx, m) * d);
-            }
-            T::medium(ctx, m, &lam).transmittance(d)
-        },
-    );
-    let c = super::bsdf::Chan(tr.to_array());
-    (!c.is_zero()).then_some((c, depth.get()))
+
+    /// A stretch of length `d` in medium `m`. An unbounded one transmits nothing: its
+    /// connection is dropped, and its depth is not needed.
+    #[inline(always)]
+    fn piece(&self, m: u32, d: f32) {
+        if d.is_finite() {
+            self.sum
+                .set(self.sum.get() + mis_extinction(self.ctx, m) * d);
+        }
+    }
 }
 
 /// The ray from `a` to `b` (at parameter 1), each end offset off its surface (`na`, `nb`;
@@ -1159,9 +1146,11 @@ fn light_to_camera<
     let m = medium_toward(ctx, qs, conn.wc);
     // The lens lies on no surface: stop just short of it (as `Camera::seen_from`).
     let ray = camera.ray_from(qs.p, qs.ng, &conn);
-    let (tr, depth) =
-        transmittance::<T, N, MOTION, MEDIA>(ctx, &ray, 1.0 - 1e-4, m, time, &qs.lam)?;
-    c = c * tr;
+    let depth = Depth::new(ctx);
+    let tr = super::light_tracer::transmittance::<T, N, MOTION, MEDIA>;
+    c = c * tr(ctx, &ray, 1.0 - 1e-4, m, time, &qs.lam, |m, d| {
+        depth.piece(m, d)
+    })?;
     let lam = joined::<T, N>(&qs.lam, &cam[0].lam, &mut c);
     if weighted {
         let prev = &light[s - 2];
@@ -1170,7 +1159,7 @@ fn light_to_camera<
         let rev = Rev {
             pt: 0.0,
             pt_minus: 0.0,
-            qs: conn.importance * cosine(qs.ng, conn.wc) * passes::<MEDIA>(depth),
+            qs: conn.importance * cosine(qs.ng, conn.wc) * passes::<MEDIA>(depth.sum.get()),
             qs_minus: density(bsdf.pdf(conn.wc, qs.wo), qs, prev) * qs.pass,
         };
         c = c * mis_weight(cam, light, s, 1, &rev, delta_light_of(light));
@@ -1229,14 +1218,15 @@ fn connect<
     stats.shadow_rays += 1;
     let m = medium_toward(ctx, pt, w);
     let (ray, t_max) = segment_ray(pt.p, pt.ng, qs.p, qs.ng);
-    let (tr, depth) = transmittance::<T, N, MOTION, MEDIA>(ctx, &ray, t_max, m, time, &pt.lam)?;
-    c = c * tr;
+    let depth = Depth::new(ctx);
+    let tr = super::light_tracer::transmittance::<T, N, MOTION, MEDIA>;
+    c = c * tr(ctx, &ray, t_max, m, time, &pt.lam, |m, d| depth.piece(m, d))?;
     let lam = joined::<T, N>(&pt.lam, &qs.lam, &mut c);
     if !weighted {
         return Some((c, lam));
     }
     let cp = &cam[t - 2];
-    let across = passes::<MEDIA>(depth);
+    let across = passes::<MEDIA>(depth.sum.get());
     let rev = Rev {
         pt: density(pdf_l, qs, pt) * across,
         pt_minus: density(bc.pdf(w, pt.wo), pt, cp) * pt.pass,
@@ -1297,13 +1287,14 @@ fn light_sample<
         }
     };
     let m = medium_toward(ctx, pt, w);
-    let (tr, depth) = transmittance::<T, N, MOTION, MEDIA>(ctx, &ray, t_max, m, time, &pt.lam)?;
-    c = c * tr;
+    let depth = Depth::new(ctx);
+    let tr = super::light_tracer::transmittance::<T, N, MOTION, MEDIA>;
+    c = c * tr(ctx, &ray, t_max, m, time, &pt.lam, |m, d| depth.piece(m, d))?;
     if !weighted {
         return Some((c, pt.lam));
     }
     let (qs, pdf_l) = light_start::<T, N>(ctx, &ls, pt)?;
-    let across = passes::<MEDIA>(depth);
+    let across = passes::<MEDIA>(depth.sum.get());
     let rev = Rev {
         pt: density(pdf_l, &qs, pt) * across,
         pt_minus: density(bc.pdf(w, pt.wo), pt, &cam[t - 2]) * pt.pass,

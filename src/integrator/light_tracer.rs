@@ -287,7 +287,16 @@ impl<'a> Camera<'a> {
     ) -> Option<C<f32, N>> {
         // The lens lies on no surface: stop just short of it.
         let ray = self.ray_from(p, n, c);
-        transmittance::<T, N, MOTION, MEDIA>(ctx, &ray, 1.0 - 1e-4, medium, time, lam)
+        let tr = transmittance::<T, N, MOTION, MEDIA>;
+        tr(
+            ctx,
+            &ray,
+            1.0 - 1e-4,
+            medium,
+            time,
+            lam,
+            |_: u32, _: f32| {},
+        )
     }
 
     /// The ray from `p` (leaving on the side of `n`; zero on no surface) to the lens point
@@ -424,8 +433,10 @@ impl CameraVertex<'_, '_> {
 }
 
 /// The transmittance along `ray` up to `t_max` at the wavelengths `lam`: with MEDIA, starting
-/// in `medium` and crossing media's boundaries; without, 1 where nothing lies on the ray.
-/// `None` where a surface (other than a boundary) blocks it.
+/// in `medium` and crossing media's boundaries, calling `piece(m, d)` for each stretch of
+/// length `d` in medium `m`; without, 1 where nothing lies on the ray. `None` where a surface
+/// (other than a boundary) blocks it.
+#[allow(clippy::too_many_arguments)]
 #[inline(always)]
 pub(super) fn transmittance<
     T: Transport<S: ChannelArray<N>>,
@@ -439,6 +450,7 @@ pub(super) fn transmittance<
     medium: u32,
     time: f32,
     lam: &T::Lanes<f32>,
+    piece: impl Fn(u32, f32),
 ) -> Option<C<f32, N>> {
     if !MEDIA {
         let clear = !ctx.scene.occluded::<MOTION>(ray, t_max, time);
@@ -451,7 +463,10 @@ pub(super) fn transmittance<
         time,
         medium,
         #[inline(always)]
-        |m, d| T::medium(ctx, m, &lam).transmittance(d),
+        |m, d| {
+            piece(m, d);
+            T::medium(ctx, m, &lam).transmittance(d)
+        },
     );
     let c = super::bsdf::Chan(tr.to_array());
     (!c.is_zero()).then_some(c)
@@ -847,7 +862,7 @@ fn trace_tile<
                 // MEDIA: seen through the media and boundaries along the ray.
                 let (ray, m) = (Ray::new(o, d), scene.camera_medium);
                 let tr = transmittance::<T, N, MOTION, MEDIA>;
-                if let Some(tr) = tr(ctx, &ray, f32::INFINITY, m, time, &lam) {
+                if let Some(tr) = tr(ctx, &ray, f32::INFINITY, m, time, &lam, |_: u32, _: f32| {}) {
                     let mut c = C::<f32, N>::splat(0.0);
                     each_infinite(ctx, |i| {
                         if let Some((le, _)) = infinite_light::<T>(ctx, i, &T::lane(&lam, 0), d) {
