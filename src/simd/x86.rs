@@ -13,6 +13,20 @@ use std::ops::{
     MulAssign, Neg, Not, Sub, SubAssign,
 };
 
+/// Runs `k` (of kernel type `K`) through entry point `$entry` of `K`'s home: the match on the
+/// constant itself is what leaves one arm per instantiation (see [`LaneKernel::SHARD`]). A
+/// home past the last is refused when the kernel is compiled. Expands to unsafe calls: the
+/// caller guarantees the entry point's CPU features.
+macro_rules! in_home {
+    ($K:ident, $k:ident, $entry:ident; $($i:literal => $home:ident),*) => {{
+        const { assert!($K::SHARD < super::SHARDS) };
+        match $K::SHARD {
+            $($i => unsafe { $home::$entry($k) },)*
+            _ => unreachable!(),
+        }
+    }};
+}
+
 /// The entry points, once in each codegen home (see [`LaneKernel::SHARD`]). Each is
 /// `#[target_feature]`, so a kernel it inlines is compiled for that instruction set.
 macro_rules! homes {
@@ -67,13 +81,8 @@ macro_rules! homes {
         /// The CPU has AVX2 and FMA.
         #[inline(always)]
         unsafe fn entry_avx2<K: LaneKernel>(k: K) -> K::Output {
-            // A home past the last is refused when the kernel is compiled.
-            const { assert!(K::SHARD < super::SHARDS) };
-            match K::SHARD {
-                // SAFETY: the caller's.
-                $($i => unsafe { $home::entry_avx2(k) },)*
-                _ => unreachable!(),
-            }
+            // SAFETY: the caller's.
+            in_home!(K, k, entry_avx2; $($i => $home),*)
         }
 
         /// [`Float::enter`] at width 16, in the kernel's home.
@@ -82,13 +91,8 @@ macro_rules! homes {
         /// The CPU has AVX-512F/BW, AVX2 and FMA.
         #[inline(always)]
         unsafe fn entry_avx512<K: LaneKernel>(k: K) -> K::Output {
-            // A home past the last is refused when the kernel is compiled.
-            const { assert!(K::SHARD < super::SHARDS) };
-            match K::SHARD {
-                // SAFETY: the caller's.
-                $($i => unsafe { $home::entry_avx512(k) },)*
-                _ => unreachable!(),
-            }
+            // SAFETY: the caller's.
+            in_home!(K, k, entry_avx512; $($i => $home),*)
         }
 
         /// [`Float::enter_typed`] at width 8, in the kernel's home.
@@ -97,13 +101,8 @@ macro_rules! homes {
         /// The CPU has AVX2 and FMA.
         #[inline(always)]
         unsafe fn entry_avx2_typed<K: TypedKernel<F8>>(k: K) -> K::Output {
-            // A home past the last is refused when the kernel is compiled.
-            const { assert!(K::SHARD < super::SHARDS) };
-            match K::SHARD {
-                // SAFETY: the caller's.
-                $($i => unsafe { $home::entry_avx2_typed(k) },)*
-                _ => unreachable!(),
-            }
+            // SAFETY: the caller's.
+            in_home!(K, k, entry_avx2_typed; $($i => $home),*)
         }
 
         /// [`Float::enter_typed`] at width 16, in the kernel's home.
@@ -112,13 +111,8 @@ macro_rules! homes {
         /// The CPU has AVX-512F/BW, AVX2 and FMA.
         #[inline(always)]
         unsafe fn entry_avx512_typed<K: TypedKernel<F16>>(k: K) -> K::Output {
-            // A home past the last is refused when the kernel is compiled.
-            const { assert!(K::SHARD < super::SHARDS) };
-            match K::SHARD {
-                // SAFETY: the caller's.
-                $($i => unsafe { $home::entry_avx512_typed(k) },)*
-                _ => unreachable!(),
-            }
+            // SAFETY: the caller's.
+            in_home!(K, k, entry_avx512_typed; $($i => $home),*)
         }
 
         /// Width 1's [`Float::enter_typed`]: the FMA entry where the CPU has FMA (its `mul_add`
